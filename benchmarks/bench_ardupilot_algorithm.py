@@ -55,7 +55,7 @@ Usage::
 (thermocal, script, [old thermocal], thermocal, …), best of ``--repeat``, each a fresh
 process with its peak resident memory and CPU time (user + system, children included: on a
 loaded machine the wall time is mostly waiting for a core), the trees byte-compiled first
-(``bench_px4_algorithm._measure``, ``_compiled``):
+(``_harness.measure_cpu``, ``compiled``):
 ``thermocal ardupilot-tempcal LOG -o DIR --allow-motion --json`` (every report) and this
 file's ``--script-only LOG`` (the script restated); ``--old-src DIR``: thermocal of another
 tree too (``git archive BASE src | tar -x -C DIR``), for before/after.
@@ -77,8 +77,8 @@ import numpy as np
 import numpy.typing as npt
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from _harness import measure
-from bench_px4_algorithm import G0, _compiled, _measure, true_bias
+from _harness import compiled, measure, measure_cpu, memory_above, race, residual_table
+from bench_px4_algorithm import G0, true_bias
 
 F64 = npt.NDArray[np.float64]
 TEMP_REF = 35.0
@@ -470,17 +470,8 @@ def main() -> None:
         + (["--no-graph"] if a.no_graph else [])  # fmt: skip
     if a.old_src is not None:
         runs["before"] = ours(str(a.old_src.resolve()), "old")
-    _compiled([Path(src)] + ([a.old_src] if a.old_src is not None else []))
-    best: dict[str, tuple[float, float, float]] = {}
-    for r in range(a.repeat):
-        for name, cmd in runs.items():
-            if name == "before" and r >= a.before_repeat:
-                continue
-            s, mb, cpu = _measure(cmd)
-            print(f"  run {r + 1} {name}: {s:.2f} s, {mb:.0f} MB peak, cpu {cpu:.2f} s "
-                  f"(load {os.getloadavg()[0]:.2f})", flush=True)  # fmt: skip
-            old = best.get(name, (math.inf, 0.0, math.inf))
-            best[name] = (min(old[0], s), max(old[1], mb), min(old[2], cpu))
+    compiled([Path(src)] + ([a.old_src] if a.old_src is not None else []))
+    best = race(runs, a.repeat, {"before": a.before_repeat})
     load1 = os.getloadavg()[0]
     _quality(work, script_parm, a.old_src is not None)
     print(f"interpreter baseline (python -c 'import numpy'): {base_mb:.0f} MB")
@@ -499,12 +490,7 @@ def main() -> None:
     tiny = work / "hard_tiny.bin"
     tiny.write_bytes(hard_log(SIZES["tiny"]))
     tiny_cmd = [str(tiny) if x == str(log) else x for x in ours(src, "tiny")]
-    tiny_mb = min(_measure(tiny_cmd)[1] for _ in range(2))
-    above = best["thermocal"][1] - tiny_mb
-    print(f"memory: peak {best['thermocal'][1]:.0f} MB on the {size_mb:.1f} MB log, "
-          f"{tiny_mb:.0f} MB on a {tiny.stat().st_size / 1e6:.2f} MB log: {above:.0f} MB above, "
-          f"{above / size_mb:.2f}x the log (target <= 2x: "
-          f"{'met' if above <= 2 * size_mb else 'NOT met'})")  # fmt: skip
+    memory_above(best["thermocal"][1], log, min(measure_cpu(tiny_cmd)[1] for _ in range(2)), tiny)
     print(f"load average: start {load0:.2f}, end {load1:.2f}")
 
 
@@ -515,15 +501,9 @@ def _quality(work: Path, script_parm: Path, before: bool) -> None:
         old = work / "out_old" / "ardupilot.parm"
         same = ours.read_bytes() == old.read_bytes()
         print(f"parameter file byte-identical to before: {same}")
-    rows = residuals(read_parm(ours), read_parm(script_parm))
-    print(f"{'axis':<10} {'thermocal':>12} {'script':>12} {'ratio':>7}")
-    for name, o, s in rows:
-        unit = "rad/s" if name.startswith("gyro") else "m/s²"
-        print(f"{name:<10} {o:12.3e} {s:12.3e} {o / s:7.2f}  {unit}")
-    ratios = [o / s for _n, o, s in rows]
-    geo = float(np.exp(np.mean(np.log(ratios))))
+    geo, worst = residual_table(residuals(read_parm(ours), read_parm(script_parm)), "script")
     print(f"ratio thermocal/script: geometric mean over the axes {geo:.2f}, worst axis "
-          f"{max(ratios):.2f}")  # fmt: skip
+          f"{worst:.2f}")  # fmt: skip
 
 
 if __name__ == "__main__":

@@ -37,7 +37,7 @@ Usage::
         [--before OLD/src]
 
 ``small`` ≈ 5 MB (seconds), ``large`` ≈ 50 MB (the issue's size).  Timed (wall and peak
-resident memory of each a fresh process as a user runs it, ``_harness.measure``), best of
+resident memory of each a fresh process as a user runs it, ``_harness.measure_cpu``), best of
 ``--repeat`` (3) runs interleaved: ``thermocal px4-tempcal LOG -o DIR`` (reports included),
 with ``--before`` the same command from another source tree (the code before a change), and
 this file's ``--px4-only LOG`` (PX4's algorithm; with ``--plots`` its PDF too, with
@@ -61,6 +61,9 @@ from typing import Any
 
 import numpy as np
 import numpy.typing as npt
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from _harness import THERMOCAL, compiled, measure_cpu, memory_above, race, residual_table
 
 F64 = npt.NDArray[np.float64]
 G0 = 9.80665
@@ -292,64 +295,9 @@ def residuals(ours: dict[str, float], px4: dict[str, float]) -> list[tuple[str, 
     return rows
 
 
-_CPU_WRAPPER = r"""
-import resource, subprocess, sys, time
-t0 = time.perf_counter()
-proc = subprocess.run(sys.argv[1:], stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
-dt = time.perf_counter() - t0
-ru = resource.getrusage(resource.RUSAGE_CHILDREN)
-print(f"{proc.returncode} {ru.ru_maxrss} {dt:.4f} {ru.ru_utime + ru.ru_stime:.4f}")
-if proc.returncode:
-    print(proc.stderr[-2000:], file=sys.stderr)
-"""
-"""``_harness.WRAPPER`` with the CPU time [s] of the child and its own children added (user
-+ system): on a loaded machine the wall time is mostly waiting for a core, the CPU time
-is what the program costs."""
-
-
-def _measure(cmd: list[str]) -> tuple[float, float, float]:
-    """(wall [s], peak resident memory of the largest process [MB], CPU [s]) of one run."""
-    import subprocess
-
-    res = subprocess.run([sys.executable, "-c", _CPU_WRAPPER, *cmd], capture_output=True,
-                         text=True, check=False)  # fmt: skip
-    code, peak_kb, wall, cpu = res.stdout.split()
-    if int(code) != 0:
-        raise SystemExit(f"{cmd} failed: {res.stderr}")
-    return float(wall), int(peak_kb) / 1024.0, float(cpu)
-
-
-def _race(cmds: dict[str, list[str]], repeat: int) -> dict[str, tuple[float, float, float]]:
-    """Best wall time [s], peak resident memory [MB] and least CPU time [s] of each command,
-    run ``repeat`` times interleaved (one of each in turn, so that a change of the machine's
-    load falls on all of them alike), each a fresh process."""
-    best: dict[str, tuple[float, float, float]] = {}
-    for r in range(repeat):
-        for name, cmd in cmds.items():
-            t, mb, cpu = _measure(cmd)
-            old = best.get(name, (math.inf, 0.0, math.inf))
-            best[name] = (min(old[0], t), max(old[1], mb), min(old[2], cpu))
-            print(f"  run {r + 1}/{repeat} {name:<16} {t:7.2f} s {mb:7.0f} MB cpu {cpu:6.2f} s "
-                  f"(load {os.getloadavg()[0]:.2f})", flush=True)  # fmt: skip
-    return best
-
-
-def _compiled(trees: list[Path]) -> None:
-    """Each source tree timed byte-compiled first (``compileall``, written even under
-    ``PYTHONDONTWRITEBYTECODE``), as an installed package is: else every run compiles
-    thermocal's modules again (≈ 1 s of CPU) while PX4's script imports only installed
-    packages."""
-    import compileall
-
-    for tree in trees:
-        compileall.compile_dir(str(tree), quiet=1)
-
-
 def _ours(tree: Path | None, log: Path, out: Path, *extra: str) -> list[str]:
     """``thermocal px4-tempcal LOG -o OUT`` as a user runs it, from this tree or ``tree``
     (the code before a change: its ``src``)."""
-    from _harness import THERMOCAL
-
     env = [] if tree is None else ["env", f"PYTHONPATH={tree}"]
     return [*env, *THERMOCAL, "px4-tempcal", str(log), "-o", str(out), "--allow-motion",
             "--json", *extra]  # fmt: skip
@@ -425,7 +373,7 @@ def main() -> None:
         _time_parse(log)
         return
     os.environ["PYTHONPATH"] = str(Path(__file__).resolve().parents[1] / "src")
-    _compiled([Path(os.environ["PYTHONPATH"]), *([a.before] if a.before else [])])
+    compiled([Path(os.environ["PYTHONPATH"]), *([a.before] if a.before else [])])
     px4_params = work / "px4_algorithm.params"
     px4 = [sys.executable, __file__, "--px4-only", str(log), "--out", str(px4_params)]
     px4 += (["--plots"] if a.plots else []) + (["--as-script"] if a.as_script else [])
@@ -433,16 +381,11 @@ def main() -> None:
     if a.before is not None:
         cmds["thermocal before"] = _ours(a.before, log, work / "out_before")
     cmds["PX4 algorithm"] = px4
-    best = _race(cmds, 1 if a.quick else a.repeat)
+    best = race(cmds, 1 if a.quick else a.repeat)
     rows = residuals(read_params(work / "out" / "px4.params"), read_params(px4_params))
-    print(f"{'axis':<10} {'thermocal':>12} {'PX4 algo':>12} {'ratio':>7}")
-    for name, ours, theirs in rows:
-        unit = "rad/s" if name.startswith("gyro") else "m/s²"
-        print(f"{name:<10} {ours:12.3e} {theirs:12.3e} {ours / theirs:7.2f}  {unit}")
-    ratios = [o / p for _n, o, p in rows]
-    geo = float(np.exp(np.mean(np.log(ratios))))
+    geo, worst = residual_table(rows, "PX4 algo")
     print(f"ratio thermocal/PX4: geometric mean over the axes {geo:.2f}, worst axis "
-          f"{max(ratios):.2f} (targets: <= 0.8, every axis <= 1)")  # fmt: skip
+          f"{worst:.2f} (targets: <= 0.8, every axis <= 1)")  # fmt: skip
     _speed_table(a, best, log, work, mb_log)
     print(f"load average after: {os.getloadavg()[0]:.2f}")
 
@@ -471,17 +414,11 @@ def _speed_table(
               f"peak {mb_old:.0f} -> {mb_ours:.0f} MB")  # fmt: skip
     tiny = work / "hard_tiny.ulg"
     tiny.write_bytes(hard_log(SIZES["tiny"])[0])
-    base = min(_measure(_ours(None, tiny, work / f"out_tiny{i}"))[1] for i in range(2))
-    above = mb_ours - base
-    print(f"memory: peak {mb_ours:.0f} MB on the {mb_log:.1f} MB log, {base:.0f} MB on a "
-          f"{tiny.stat().st_size / 1e6:.2f} MB log: {above:.0f} MB above, "
-          f"{above / mb_log:.2f}x the log (peak RSS of the largest process, wrapper's "
-          "RUSAGE_CHILDREN)")  # fmt: skip
+    base = min(measure_cpu(_ours(None, tiny, work / f"out_tiny{i}"))[1] for i in range(2))
+    memory_above(mb_ours, log, base, tiny)
     if a.as_script:
         ok = t_ours / t_px4 <= 1 / 1.5
         print(f"target (<= 0.667 of PX4's script's time): {'met' if ok else 'NOT met'}")
-        print(f"target (<= 2x the log's size above a tiny log's): "
-              f"{'met' if above <= 2 * mb_log else 'NOT met'}")  # fmt: skip
 
 
 if __name__ == "__main__":

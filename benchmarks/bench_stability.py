@@ -10,8 +10,10 @@ target (≥ 3×) and the deviations are compared (relative 1e-6); the load avera
 start and end is printed (the machine may be shared: ratios measured in the same run are
 what counts).
 
-Skipped at 10⁷ (``--n`` smaller runs them): mtotdev, ttotdev, htotdev and theo1 are
-O(N·m) per τ in both programs (≈ N²/2 element operations at the largest octave τ: hours);
+Skipped at 10⁷ (``--n`` smaller runs them): mtotdev, ttotdev and htotdev are O(N·m) per τ
+in allantools (≈ N²/2 element operations at the largest octave τ: hours), O(N log m) in
+thermocal (``stability/total.py``; ``bench_total_family.py`` times them against a reference
+at sizes allantools finishes); theo1 is O(N·m) per τ in both programs;
 mtie in allantools is O(N·m) in time and memory (a rolling window of m + 1 columns), while
 thermocal's is O(N) per τ (running max/min).
 
@@ -31,7 +33,7 @@ ALL = ("oadev", "adev", "mdev", "tdev", "hdev", "ohdev", "totdev", "tierms",
 SLOW_ON_BOTH = {"mtotdev", "ttotdev", "htotdev", "theo1"}
 SLOW_IN_ALLANTOOLS = {"mtie"}
 BIG = 2_000_000
-"""Above this many samples the O(N·m) deviations are skipped."""
+"""Above this many samples the deviations O(N·m) in allantools (or in both) are skipped."""
 
 
 def best_of(fn, repeats: int) -> tuple[float, object]:  # type: ignore[no-untyped-def]
@@ -66,7 +68,7 @@ def main() -> int:
     print(f"start: {load} (1, 5, 15 min; other jobs on the machine)")
     for name in names:
         if args.n > BIG and name in SLOW_ON_BOTH:
-            print(f"{name:8s} skipped: O(N·m) per τ in both programs at this size")
+            print(f"{name:8s} skipped: O(N·m) per τ in allantools at this size")
             continue
         if args.n > BIG and name in SLOW_IN_ALLANTOOLS:
             t_ours, _ = best_of(lambda: stability(y, tau0, [name], "octave"), args.repeat)  # noqa: B023

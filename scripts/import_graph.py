@@ -28,8 +28,10 @@ LAYERS: dict[str, int] = {
     "recording": 1, "families": 1,
     # 2 maths: pure functions on arrays
     "preprocess": 2, "thermometer": 2, "metrics": 2, "profiles": 2, "inspection": 2, "adequacy": 2, "gravity": 2,
+    "heater": 2,
     "stability": 2, "models": 2, "compensate.kernels": 2, "simulate": 2, "turntable": 2,
     "multipos": 2, "datasets": 2, "compensate": 2, "firmware": 2, "metrics_streaming": 2,
+    "ratetable": 2,
     # 3 files: reading, writing, model files, the drivers that stream files
     "readers": 3, "writers": 3,
     "validation": 3, "export": 3, "tempcal": 3,

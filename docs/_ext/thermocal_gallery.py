@@ -98,10 +98,20 @@ def _tempcal(run: Callable[..., str], here: Path) -> list[Path]:
     return sorted((here / "px4").glob("*.html")) + sorted((here / "ardupilot").glob("*.html"))
 
 
+def _ratetable(run: Callable[..., str], here: Path) -> list[Path]:
+    """A gyro's rate ladder at three temperatures (``simulate ratetable``)."""
+    run("simulate", "ratetable", "--runs", "3", "-o", "rt")
+    ladders = [f"rt/ratetable_T{t}.csv" for t in ("-20", "+20", "+60")]
+    run("ratetable", *ladders, "--rate-column", "table_rate", "--temps", "temp",
+        "--report", "ratetable.html")  # fmt: skip
+    return [here / "ratetable.html"]
+
+
 SCENARIOS: tuple[Callable[[Callable[..., str], Path], list[Path]], ...] = (
     _chamber,
     _imu,
     _triads,
+    _ratetable,
     _fleet,
     _tempcal,
 )

@@ -44,6 +44,7 @@ SCENARIO_NAMES: Final = (
     "turntable-thermal",
     "mems-imu",
     "multipos",
+    "ratetable",
 )
 """The simulator's scenarios (:data:`thermocal.simulate.SCENARIOS`, a test checks they agree)."""
 

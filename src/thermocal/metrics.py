@@ -1052,16 +1052,7 @@ def reference_bias(
     r = _as_1d(rate, "rate")
     t0 = t[0]
     duration = float(t[-1] - t0)
-    if window_s is None:
-        start, end = 0.0, DEFAULT_DRIFT_REFERENCE_FRACTION * duration
-    else:
-        start, end = float(window_s[0]), float(window_s[1])
-        if not (math.isfinite(start) and math.isfinite(end) and end > start >= 0.0):
-            raise ThermocalInputError.naming(
-                f"{{drift_reference_s}} {start:g},{end:g}: give START,END in seconds since "
-                "the first sample, with 0 ≤ START < END",
-                "drift_reference_s",
-            )
+    start, end = drift_reference_window(window_s, duration)
     if is_increasing(t):  # the window is one stretch: found by bisection, no copy
         # t_i − t_0 is non-decreasing in i (rounding is monotone): the rows with
         # start ≤ t_i − t_0 ≤ end are i0 … i1 − 1
@@ -1075,13 +1066,135 @@ def reference_bias(
         n = int(np.count_nonzero(sel))
         selected = r[sel]
     if n == 0:
-        raise ThermocalInputError.naming(
-            f"drift reference window {start:g}…{end:g} s holds no sample (the run lasts "
-            f"{duration:g} s from its first sample); choose another {{drift_reference_s}}",
-            "drift_reference_s",
-        )
+        raise empty_reference_window(start, end, duration)
     b0 = float(np.mean(selected)) - float(earth_rate)
     return DriftReference("window", start, end, b0, unit, n)
+
+
+def drift_reference_window(
+    window_s: tuple[float, float] | None, duration_s: float
+) -> tuple[float, float]:
+    """The drift angle's reference window, checked: the one given, else the first
+    :data:`DEFAULT_DRIFT_REFERENCE_FRACTION` of the run (shared by the in-memory and the
+    window-by-window metrics).
+
+    Parameters
+    ----------
+    window_s : tuple of float or None
+        The window (start, end) given [s since the first sample], or None.
+    duration_s : float
+        The run's last minus first time [s].
+
+    Returns
+    -------
+    tuple of float
+        (start, end) [s since the first sample].
+
+    Raises
+    ------
+    thermocal.errors.ThermocalInputError
+        A window that is not finite with 0 ≤ start < end (naming ``drift_reference_s``).
+
+    Examples
+    --------
+    >>> drift_reference_window(None, 3600.0)
+    (0.0, 360.0)
+    """
+    if window_s is None:
+        return 0.0, DEFAULT_DRIFT_REFERENCE_FRACTION * duration_s
+    start, end = float(window_s[0]), float(window_s[1])
+    if not (math.isfinite(start) and math.isfinite(end) and end > start >= 0.0):
+        raise ThermocalInputError.naming(
+            f"{{drift_reference_s}} {start:g},{end:g}: give START,END in seconds since "
+            "the first sample, with 0 ≤ START < END",
+            "drift_reference_s",
+        )
+    return start, end
+
+
+def empty_reference_window(start: float, end: float, duration_s: float) -> ThermocalInputError:
+    """The error for a drift reference window that holds no sample.
+
+    Parameters
+    ----------
+    start, end : float
+        The window [s since the first sample].
+    duration_s : float
+        The run's last minus first time [s].
+
+    Returns
+    -------
+    thermocal.errors.ThermocalInputError
+        The error to raise (naming ``drift_reference_s``).
+    """
+    return ThermocalInputError.naming(
+        f"drift reference window {start:g}…{end:g} s holds no sample (the run lasts "
+        f"{duration_s:g} s from its first sample); choose another {{drift_reference_s}}",
+        "drift_reference_s",
+    )
+
+
+def drift_options(
+    name: str,
+    unit: str,
+    drift_reference_s: tuple[float, float] | None,
+    drift_bias: float | None,
+) -> tuple[str, float, DriftReference | None] | None:
+    r"""What the drift angle of one channel takes, its options checked (shared by the
+    in-memory and the window-by-window metrics): None for a signal that is not a gyro
+    rate (where the drift options are an error), else the angle's unit, the rate unit's
+    time [s] and the given bias b0 (None: b0 is the mean over the reference window).
+
+    Parameters
+    ----------
+    name : str
+        The channel, named in errors.
+    unit : str
+        Its data unit.
+    drift_reference_s : tuple of float or None
+        The reference window given [s since the first sample].
+    drift_bias : float or None
+        b0 given [``unit``, earth rate removed].
+
+    Returns
+    -------
+    tuple or None
+        ``(angle_unit, per_s, reference)``: θ in ``angle_unit`` is
+        :math:`\int (\omega - \Omega - b_0)\,dt / \mathrm{per\_s}`; ``reference`` the
+        :class:`DriftReference` of a given b0, else None.
+
+    Raises
+    ------
+    thermocal.errors.ThermocalInputError
+        Drift options for a signal that is not a rate, both options given, or a bias that
+        is not a number.
+
+    Examples
+    --------
+    >>> drift_options("gz", "deg/h", None, 0.5)[2].bias
+    0.5
+    """
+    if unit not in RATE_ANGLE_UNITS:
+        if drift_bias is not None or drift_reference_s is not None:
+            raise ThermocalInputError.naming(
+                f"the drift angle applies to gyro rates, but {name!r} is in {unit}: "
+                "{drift_reference_s}/{drift_bias} do not apply",
+                "drift_reference_s",
+                "drift_bias",
+            )
+        return None
+    angle_unit, per = RATE_ANGLE_UNITS[unit]
+    if drift_bias is None:
+        return angle_unit, per, None
+    if drift_reference_s is not None:
+        raise ThermocalInputError.naming(
+            "give either {drift_reference_s} or {drift_bias}, not both",
+            "drift_reference_s",
+            "drift_bias",
+        )
+    if not math.isfinite(drift_bias):
+        raise ParameterError("drift_bias", f"{{name}} must be a number, got {drift_bias!r}")
+    return angle_unit, per, DriftReference("bias", None, None, float(drift_bias), unit)
 
 
 # --- recording pipeline ------------------------------------------------------------------
@@ -1164,7 +1277,7 @@ def data_unit_of(rec: Recording, name: str, canonical: str) -> tuple[str, float]
     return shown.unit, shown.to_model
 
 
-def _earth_rate(
+def earth_rate_to_remove(
     rec: Recording,
     name: str,
     canon: str,
@@ -1173,9 +1286,47 @@ def _earth_rate(
     latitude_deg: float | None,
     axis: str | None,
 ) -> float:
-    """The earth rate on the sensitive axis [data unit] to remove: 0 unless a latitude or
+    r"""The earth rate on the sensitive axis [data unit] to remove: 0 unless a latitude or
     an axis is given (options, else the recording's metadata); both are then needed, and
-    the signal must be a gyro rate (:func:`thermocal.units.earth_rate_on_axis_deg_h` / k)."""
+    the signal must be a gyro rate.
+
+    Parameters
+    ----------
+    rec : Recording
+        The recording (its metadata's latitude and axis when none is given).
+    name : str
+        The signal, named in errors.
+    canon : str
+        Its canonical unit (``deg/h`` for a gyro rate).
+    unit : str
+        Its data unit.
+    k : float
+        Canonical per data unit (:func:`data_unit_of`).
+    latitude_deg : float or None
+        Site latitude [°].
+    axis : str or None
+        Sensitive axis (``up``, ``north``, … or ``'e,n,u'``).
+
+    Returns
+    -------
+    float
+        Ω_axis [``unit``].
+
+    Raises
+    ------
+    thermocal.errors.ThermocalInputError
+        Only one of latitude and axis, a signal that is not a rate, or a latitude beyond ±90°.
+
+    Notes
+    -----
+    .. math:: \Omega_\mathrm{axis} = \Omega\,\mathbf u \cdot (0, \cos\varphi, \sin\varphi) / k
+
+    (:func:`thermocal.units.earth_rate_on_axis_deg_h`, east-north-up axes).
+
+    References
+    ----------
+    - IEEE Std 952-1997, earth rate as an input of a stationary gyro.
+    """
     lat = latitude_deg if latitude_deg is not None else rec.meta.latitude_deg
     ax = axis if axis is not None else rec.meta.axis
     if lat is None and axis is None:
@@ -1205,27 +1356,11 @@ def _drift(
     """The drift angle's reference bias b0 and ``θ(t) = ∫ (ω − Ω_axis − b0) dt`` at the
     end and at its largest (gyro rates only; None otherwise, where the drift options are
     an error)."""
-    if unit not in RATE_ANGLE_UNITS:
-        if drift_bias is not None or drift_reference_s is not None:
-            raise ThermocalInputError.naming(
-                f"the drift angle applies to gyro rates, but {name!r} is in {unit}: "
-                "{drift_reference_s}/{drift_bias} do not apply",
-                "drift_reference_s",
-                "drift_bias",
-            )
+    plan = drift_options(name, unit, drift_reference_s, drift_bias)
+    if plan is None:
         return None
-    angle_unit, per = RATE_ANGLE_UNITS[unit]
-    if drift_bias is not None:
-        if drift_reference_s is not None:
-            raise ThermocalInputError.naming(
-                "give either {drift_reference_s} or {drift_bias}, not both",
-                "drift_reference_s",
-                "drift_bias",
-            )
-        if not math.isfinite(drift_bias):
-            raise ParameterError("drift_bias", f"{{name}} must be a number, got {drift_bias!r}")
-        ref = DriftReference("bias", None, None, float(drift_bias), unit)
-    else:
+    angle_unit, per, ref = plan
+    if ref is None:
         ref = reference_bias(t, values, window_s=drift_reference_s, earth_rate=earth, unit=unit)
     ext = drift_angle_extreme(t, values, ref.bias + earth, time_unit_s=per, unit=angle_unit)
     return ref, ext
@@ -1314,7 +1449,7 @@ def compute_metrics(
     t = rec.time_s
     tau0 = rec.sample_interval_s
     avg = float(averaging_s) if averaging_s is not None else tau0
-    earth = _earth_rate(rec, name, canon, unit, k, latitude_deg, axis)
+    earth = earth_rate_to_remove(rec, name, canon, unit, k, latitude_deg, axis)
     b0 = bias(values, earth_rate_deg_h=earth)
     means = block_means(values, tau0, avg, time_s=t)
     if means.size < 2:
@@ -1650,6 +1785,10 @@ __all__ = [
     "data_unit_of",
     "drift_angle",
     "drift_angle_extreme",
+    "drift_options",
+    "drift_reference_window",
+    "earth_rate_to_remove",
+    "empty_reference_window",
     "hold_stages",
     "peak_to_peak",
     "power_on_metrics",

@@ -20,7 +20,6 @@ import numpy as np
 import numpy.typing as npt
 
 from thermocal import metrics as mt
-from thermocal.errors import ParameterError, ThermocalInputError
 from thermocal.stability.streaming import ArrayStore, BlockSource, BlockStore, exact_sum
 
 FloatArray = npt.NDArray[np.float64]
@@ -82,16 +81,7 @@ def _reference_window(
     n = time.size
     t0, t_end = float(time.read(0, 1)[0]), float(time.read(n - 1, n)[0])
     duration = t_end - t0
-    if window_s is None:
-        start, end = 0.0, mt.DEFAULT_DRIFT_REFERENCE_FRACTION * duration
-    else:
-        start, end = float(window_s[0]), float(window_s[1])
-        if not (math.isfinite(start) and math.isfinite(end) and end > start >= 0.0):
-            raise ThermocalInputError.naming(
-                f"{{drift_reference_s}} {start:g},{end:g}: give START,END in seconds since "
-                "the first sample, with 0 ≤ START < END",
-                "drift_reference_s",
-            )
+    start, end = mt.drift_reference_window(window_s, duration)
     i0 = i1 = n
     for a, b in _windows(0, n):
         rel = time.read(a, b) - t0
@@ -102,11 +92,7 @@ def _reference_window(
             break
     count = max(i1 - i0, 0)
     if count == 0:
-        raise ThermocalInputError.naming(
-            f"drift reference window {start:g}…{end:g} s holds no sample (the run lasts "
-            f"{duration:g} s from its first sample); choose another {{drift_reference_s}}",
-            "drift_reference_s",
-        )
+        raise mt.empty_reference_window(start, end, duration)
     b0 = _mean(rate, i0, i1) - float(earth)
     return mt.DriftReference("window", start, end, b0, unit, count)
 
@@ -227,10 +213,9 @@ def streamed_metrics(
         store.remove(means)
     report(0.25)
     ref = ext = None
-    if unit in mt.RATE_ANGLE_UNITS or drift_bias is not None or drift_reference_s is not None:
-        ref, ext = _drift(
-            time, rate, segments, name, unit, earth_rate, drift_reference_s, drift_bias
-        )
+    drift = _drift(time, rate, segments, name, unit, earth_rate, drift_reference_s, drift_bias)
+    if drift is not None:
+        ref, ext = drift
     report(0.5)
     t_first, t_last = float(time.read(0, 1)[0]), float(time.read(n - 1, n)[0])
     return _result(
@@ -273,27 +258,14 @@ def _drift(
     earth: float,
     drift_reference_s: tuple[float, float] | None,
     drift_bias: float | None,
-) -> tuple[mt.DriftReference | None, mt.DriftExtreme | None]:
-    """:func:`thermocal.metrics._drift` on stores."""
-    if unit not in mt.RATE_ANGLE_UNITS:
-        raise ThermocalInputError.naming(
-            f"the drift angle applies to gyro rates, but {name!r} is in {unit}: "
-            "{drift_reference_s}/{drift_bias} do not apply",
-            "drift_reference_s",
-            "drift_bias",
-        )
-    angle_unit, per = mt.RATE_ANGLE_UNITS[unit]
-    if drift_bias is not None:
-        if drift_reference_s is not None:
-            raise ThermocalInputError.naming(
-                "give either {drift_reference_s} or {drift_bias}, not both",
-                "drift_reference_s",
-                "drift_bias",
-            )
-        if not math.isfinite(drift_bias):
-            raise ParameterError("drift_bias", f"{{name}} must be a number, got {drift_bias!r}")
-        ref = mt.DriftReference("bias", None, None, float(drift_bias), unit)
-    else:
+) -> tuple[mt.DriftReference, mt.DriftExtreme] | None:
+    """The drift angle's b0 and extremes on stores, its options checked by
+    :func:`thermocal.metrics.drift_options` (None: not a gyro rate)."""
+    plan = mt.drift_options(name, unit, drift_reference_s, drift_bias)
+    if plan is None:
+        return None
+    angle_unit, per, ref = plan
+    if ref is None:
         ref = _reference_window(time, rate, drift_reference_s, earth, unit)
     ext = _drift_extreme(time, rate, segments, ref.bias + earth, per, angle_unit)
     return ref, ext

@@ -34,6 +34,10 @@ from thermocal.recording import FloatArray, Recording
 
 MIN_STEP_C = 0.1
 """A lattice step from which a thermometer is called quantised [°C]."""
+MAX_STEP_C = 2.0
+"""The coarsest lattice step taken for a thermometer's resolution [°C] (the coarsest IMU
+thermometers read whole degrees): readings on a coarser lattice are set temperatures of the
+record (soaks) and are not reconstructed between their changes."""
 MIN_PERIOD_S = 1.0
 """An update period from which a thermometer is called slow [s]."""
 ON_LATTICE = 0.05
@@ -76,7 +80,7 @@ class Thermometer:
     sample_period_s : float
         The median interval between samples [s].
     quantised : bool
-        ``step_c`` ≥ :data:`MIN_STEP_C`.
+        :data:`MIN_STEP_C` ≤ ``step_c`` ≤ :data:`MAX_STEP_C`.
     slow : bool
         ``update_period_s`` ≥ :data:`MIN_PERIOD_S` and at least 5 sample intervals.
     """
@@ -275,8 +279,8 @@ def describe_thermometer(time_s: FloatArray, temp_c: FloatArray) -> Thermometer:
     -------
     Thermometer
         Levels, lattice step [°C], update period [s], and whether it is quantised (a step of
-        at least :data:`MIN_STEP_C`) or slow (updated every :data:`MIN_PERIOD_S` or more,
-        and at least every 5 samples).
+        at least :data:`MIN_STEP_C`, at most :data:`MAX_STEP_C`) or slow (updated every
+        :data:`MIN_PERIOD_S` or more, and at least every 5 samples).
 
     Raises
     ------
@@ -312,7 +316,7 @@ def describe_thermometer(time_s: FloatArray, temp_c: FloatArray) -> Thermometer:
         step_c=step,
         update_period_s=period,
         sample_period_s=dt,
-        quantised=step is not None and step >= MIN_STEP_C,
+        quantised=step is not None and MIN_STEP_C <= step <= MAX_STEP_C,
         slow=period is not None and period >= MIN_PERIOD_S and period >= 5 * dt,
     )
 
@@ -684,6 +688,7 @@ def reconstruct_columns(
 
 
 __all__ = [
+    "MAX_STEP_C",
     "MIN_PERIOD_S",
     "MIN_STEP_C",
     "Reconstruction",

@@ -90,3 +90,18 @@ def test_a_commands_help_loads_no_pydantic() -> None:
     )
     res = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert res.stdout.split() == ["0", "False", "False"]
+
+
+@pytest.mark.parametrize(
+    "group", [[], ["station"], ["profile"]], ids=["root", "station", "profile"]
+)
+def test_a_group_alone_prints_its_help_as_help_does(group: list[str], capsys) -> None:  # type: ignore[no-untyped-def]
+    """``thermocal`` (or a group) without a command prints the same help as ``--help``, on
+    stdout, with its line breaks, and exits 0 (click ≥ 8.2 and typer ≥ 0.28 raise it as a usage
+    error: the help was squashed into one ``error:`` line with exit 2)."""
+    assert cli.main([*group, "--help"]) == 0
+    expected = capsys.readouterr().out
+    assert cli.main(group) == 0
+    out, err = capsys.readouterr()
+    assert out.rstrip("\n") == expected.rstrip("\n")
+    assert out.count("\n") > 5 and err == ""

@@ -65,6 +65,8 @@ COMMANDS: dict[str, list[str]] = {
                       "--temps", "T1", "-o", "{o}.json"],
     "compensate": ["compensate", "{m}", "{f}", "-o", "{o}.csv"],
     "validate": ["validate", "{m}", "{f}"],
+    "ratetable": ["ratetable", "{f}", "--gyro", "gyro", "--gyro-unit", "deg/s", "--time-unit",
+                  "s", "--temps", "T1", "--rates=-10,10", "--min-plateau", "1", "--window", "1"],
 }  # fmt: skip
 UNITS = ["--signal-unit", "deg/h", "--time-unit", "s"]
 TEMP_UNITS = ["--temp-unit", "degC"]
@@ -104,7 +106,7 @@ def test_every_command_exits_0_or_2(
     f = tmp_path / "rec.csv"
     f.write_text(text)
     args = [a.format(f=f, o=tmp_path / "out", m=model) for a in COMMANDS[command]]
-    if command not in ("compensate", "validate"):
+    if command not in ("compensate", "validate", "ratetable"):
         args += UNITS + TEMP_UNITS
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")  # numerical warnings are shown as warning: lines

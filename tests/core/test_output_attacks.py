@@ -101,6 +101,11 @@ def assets(tmp_path_factory: pytest.TempPathFactory) -> Path:
     ]
     (d / "log.bin").write_bytes(imu_log(bin_rows))
     write_run(d / "U1.csv", 7)
+    from thermocal.ratetable.simulate import simulate_ladder
+
+    rt, _ = simulate_ladder(np.random.default_rng(0), rates_dps=(-10.0, 0.0, 10.0), dwell_s=6.0,
+                            rate_hz=20.0)  # fmt: skip
+    write_recording(rt, d / "rt.csv")
     (d / "batch.toml").write_text(config_text({"U1": ("U1.csv", None)}), encoding="utf-8")
     return d
 
@@ -153,6 +158,10 @@ COMMANDS = [
             "--truth", o], ("prog.csv",), suffix=".json"),
     Command("turntable", lambda i, o: ["turntable", _s(i["tt.csv"]), "-o", o], ("tt.csv",),
             suffix=".json"),
+    Command("ratetable", lambda i, o: ["ratetable", _s(i["rt.csv"]), "--rate-column",
+            "table_rate", "-o", o], ("rt.csv",), suffix=".json"),
+    Command("ratetable-report", lambda i, o: ["ratetable", _s(i["rt.csv"]), "--rate-column",
+            "table_rate", "--report", o], ("rt.csv",), suffix=".html"),
     Command("px4-tempcal", lambda i, o: ["px4-tempcal", _s(i["log.ulg"]), "-o", o],
             ("log.ulg",), kind="dir", writes="calibration.json"),
     Command("ardupilot-tempcal", lambda i, o: ["ardupilot-tempcal", _s(i["log.bin"]), "-o", o],

@@ -161,6 +161,8 @@ SOURCES = {
     r"Buitinck": "L. Buitinck",
     r"FIPS 180|FIPS PUB 180": "FIPS PUB 180-4",
     r"RFC 4180": "RFC 4180",
+    r"heater_params\.c": "heater_params.c",
+    r"AP_BoardConfig\.cpp": "AP_BoardConfig.cpp",
 }
 """Every published source the package's code cites, and the methods chapter's entry for it."""
 

@@ -217,6 +217,7 @@ def _imu_runs(t: Path) -> list[tuple[str, Any]]:
         ("allan", _run(["allan", val, "--signal", "gx,gy"])),
         ("allan", _run(["allan", val, "--signal", "gx", "--deviation", "mdev,hdev"])),
         ("allan", _run(["allan", val, "--signal", "gx", "--dynamic", "20000"])),
+        ("allan", _run(["allan", val, "--signal", "gx", "--temps", "T_die", "--temp-bins", "20"])),
         ("metrics", _run(["metrics", *runs, "--signal", "gyro"])),
     ]  # fmt: skip
 
@@ -224,15 +225,18 @@ def _imu_runs(t: Path) -> list[tuple[str, Any]]:
 def _other_runs(t: Path) -> list[tuple[str, Any]]:
     """Flight-controller logs, the turntable, multipos, a batch and the demonstrations."""
     _run(["simulate", "turntable-16", "-o", str(t / "tt.csv")])
+    _run(["simulate", "ratetable", "--runs", "2", "-o", str(t / "rt")])
+    rt = sorted(str(p) for p in (t / "rt").glob("*.csv"))
     for seed in (1, 2):
         _run(["simulate", "fog-slow", "-o", str(t / f"SN{seed}.csv"), "--seed", str(seed),
               "--rate-hz", "0.1"])  # fmt: skip
     (t / "batch.toml").write_text(FLEET_TOML)
     px4 = t / "px4"
     return [
-        ("px4-tempcal", _run(["px4-tempcal", str(LOGS / "sweep.ulg"), "-o", str(px4)])),
+        ("px4-tempcal", _run(["px4-tempcal", str(LOGS / "sweep.ulg"), "-o", str(px4),
+                              "--emulate-learning"])),
         ("ardupilot-tempcal", _run(["ardupilot-tempcal", str(LOGS / "sweep.bin"),
-                                    "-o", str(t / "ap")])),
+                                    "-o", str(t / "ap"), "--emulate-learning"])),
         ("export-params", _run(["export-params", str(px4 / "calibration.json"),
                                 "--format", "px4", "-o", str(t / "x.params")])),
         ("turntable", _run(["turntable", str(t / "tt.csv"), "-o", str(t / "tt.json"),
@@ -243,6 +247,7 @@ def _other_runs(t: Path) -> list[tuple[str, Any]]:
                            "--accel-unit", "m/s^2", "--gyro", "gyr_x,gyr_y,gyr_z",
                            "--gyro-unit", "deg/s", "--gravity", "9.81",
                            "-o", str(t / "mp.json")])),
+        ("ratetable", _run(["ratetable", *rt, "--rate-column", "table_rate", "--temps", "temp"])),
         ("fleet", _run(["fleet", str(t / "batch.toml"), "-o", str(t / "bo"), "--workers", "1"])),
         ("demo", _run(["demo", "--quick", "-o", str(t / "d1")])),
         ("demo", _run(["demo", "--quick", "--imu", "-o", str(t / "d2")])),

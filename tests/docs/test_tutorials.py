@@ -46,6 +46,7 @@ def test_every_tutorial_is_executed_here() -> None:
         "notebook-poly.md",  # tests/docs/test_tutorial_notebook_poly.py
         "notebook-px4.md",  # tests/docs/test_tutorial_notebook_px4.py
         "production-batch.md",  # tests/docs/test_tutorials_b.py
+        "ratetable.md",  # tests/docs/test_tutorial_ratetable.py
         "ros-bags.md",  # tests/docs/test_tutorial_ros_bags.py
         "stability-stable32.md",
         "station.md",  # tests/docs/test_tutorial_station.py

@@ -237,7 +237,7 @@ def _holds(term: tuple[float, float, float], truth: float) -> bool:
 
 def test_noise_tutorial_prints_what_the_page_shows(noise: Pages) -> None:
     pairs, _ = noise
-    assert len(pairs) == 4
+    assert len(pairs) == 9
     for printed, shown in pairs:
         assert _numbers(printed) == _numbers(shown)
     page = (TUTORIALS / "noise-for-estimator.md").read_text(encoding="utf-8")

@@ -152,12 +152,14 @@ def test_the_shipped_logs_are_what_their_script_makes() -> None:
     make = _make_fc_logs()
     assert (DATA / "sweep.ulg").read_bytes() == make.ulog()
     assert (DATA / "sweep.bin").read_bytes() == make.dataflash()
+    assert (DATA / "heated.ulg").read_bytes() == make.heated()
     assert sum(p.stat().st_size for p in DATA.iterdir()) < 500_000
 
 
 def test_fc_tutorial_prints_what_the_page_shows(fc_page: tuple[Path, Page]) -> None:
     _, page = fc_page
-    assert [codes for _p, _s, codes in page] == [[0], [], [0], [0], []]
+    # the fifth: heated; the sixth: the thermometers' python block
+    assert [codes for _p, _s, codes in page] == [[0], [], [0], [0], [0], []]
     for printed, shown, _codes in page:
         assert _numbers(printed) == _numbers(shown)
         assert _lines(printed) == _lines(shown)

@@ -377,6 +377,7 @@ def test_scenario_registry_and_bad_input() -> None:
         "turntable-thermal",
         "mems-imu",
         "multipos",
+        "ratetable",
     }
     with pytest.raises(ThermocalInputError, match="unknown scenario"):
         run_scenario("nope", 0)

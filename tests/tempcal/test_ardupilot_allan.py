@@ -5,61 +5,23 @@ way."""
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
-from typing import Any
 
-import numpy as np
 import pytest
 
 pytest.importorskip("pymavlink")
 
-import thermocal.report.calibration as calibration_report
-from dataflash_writer import imu_log
-from thermocal.cli import main
-
-
-def _log(tmp_path: Path, n: int = 6000) -> Path:
-    """One IMU over a −10…50 °C sweep (rad/s, m/s²), the IMU message of today's firmware."""
-    rng = np.random.default_rng(41)
-    t = np.arange(n) * 0.1
-    temp = -10.0 + 60.0 * (0.5 - 0.5 * np.cos(np.pi * t / t[-1]))
-    x = (temp - 20.0) / 30.0
-    g = np.column_stack([0.002 + 0.004 * x, -0.003 * x, 0.006 * x**2])
-    a = np.column_stack([0.05 + 0.08 * x, -0.06 * x, -9.80665 + 0.1 * x])
-    g, a = g + rng.normal(0, 1e-4, (n, 3)), a + rng.normal(0, 2e-3, (n, 3))
-    rows = [
-        (int(1e6 + ti * 1e6), 0, *map(float, gg), *map(float, aa), 0, 0, float(tt))
-        for ti, gg, aa, tt in zip(t, g, a, temp, strict=True)
-    ]
-    log = tmp_path / "s.bin"
-    log.write_bytes(imu_log(rows))
-    return log
-
-
-def _run(log: Path, out: Path, capsys: pytest.CaptureFixture[str], *extra: str) -> dict[str, Any]:
-    code = main(["ardupilot-tempcal", str(log), "-o", str(out), "--json", *extra])
-    captured = capsys.readouterr()
-    assert code == 0, captured.err
-    result: dict[str, Any] = json.loads(captured.out)
-    return result
+from fc_sweeps import ardupilot_sweep_log, count_allan_calls, run_json
 
 
 def test_allan_section_only_when_asked(
     tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    calls: list[int] = []
-    real = calibration_report.allan_of
-
-    def counted(*args: Any, **kwargs: Any) -> Any:
-        calls.append(1)
-        return real(*args, **kwargs)
-
-    monkeypatch.setattr(calibration_report, "allan_of", counted)
-    log = _log(tmp_path)
-    plain = _run(log, tmp_path / "plain", capsys)
+    calls = count_allan_calls(monkeypatch)
+    log = ardupilot_sweep_log(tmp_path / "s.bin", 6000, 0.1, 41)
+    plain = run_json("ardupilot-tempcal", log, tmp_path / "plain", capsys)
     assert calls == []  # nothing of the Allan section computed
-    asked = _run(log, tmp_path / "asked", capsys, "--allan")
+    asked = run_json("ardupilot-tempcal", log, tmp_path / "asked", capsys, "--allan")
     assert len(calls) == 2 * 3 * 2  # gyro and accelerometer, three axes, before and after
     for name in ("report_IMU_0_gyro.html", "report_IMU_0_accel.html"):
         without = (tmp_path / "plain" / name).read_text()

@@ -5,43 +5,12 @@ the report, the parameters and the JSON are the same either way."""
 
 from __future__ import annotations
 
-import json
 import re
 from pathlib import Path
-from typing import Any
 
-import numpy as np
 import pytest
 
-import thermocal.report.calibration as calibration_report
-from thermocal.cli import main
-from ulog_writer import SENSOR_FIELDS, ulog_bytes
-
-
-def _log(tmp_path: Path, n: int = 6000) -> Path:
-    """A gyro and an accelerometer over a −10…50 °C sweep, cubic-free biases (rad/s, m/s²)."""
-    rng = np.random.default_rng(41)
-    t = np.arange(n) * 0.1
-    temp = -10.0 + 60.0 * (0.5 - 0.5 * np.cos(np.pi * t / t[-1]))
-    x = (temp - 20.0) / 30.0
-    g = np.column_stack([0.002 + 0.004 * x, -0.003 * x, 0.006 * x**2])
-    a = np.column_stack([0.05 + 0.08 * x, -0.06 * x, -9.80665 + 0.1 * x])
-    g, a = g + rng.normal(0, 1e-4, (n, 3)), a + rng.normal(0, 2e-3, (n, 3))
-    ts = (1e6 + t * 1e6).astype(np.int64)
-    rows_g = [(int(s), 7, *map(float, v), float(T)) for s, v, T in zip(ts, g, temp, strict=True)]
-    rows_a = [(int(s), 8, *map(float, v), float(T)) for s, v, T in zip(ts, a, temp, strict=True)]
-    log = tmp_path / "s.ulg"
-    log.write_bytes(ulog_bytes([("sensor_gyro", 0, SENSOR_FIELDS, rows_g),
-                                ("sensor_accel", 0, SENSOR_FIELDS, rows_a)]))  # fmt: skip
-    return log
-
-
-def _run(log: Path, out: Path, capsys: pytest.CaptureFixture[str], *extra: str) -> dict[str, Any]:
-    code = main(["px4-tempcal", str(log), "-o", str(out), "--json", *extra])
-    captured = capsys.readouterr()
-    assert code == 0, captured.err
-    result: dict[str, Any] = json.loads(captured.out)
-    return result
+from fc_sweeps import count_allan_calls, px4_sweep_log, run_json
 
 
 def _section(html: str, ident: str) -> str:
@@ -52,18 +21,11 @@ def _section(html: str, ident: str) -> str:
 def test_allan_section_only_when_asked(
     tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    calls: list[int] = []
-    real = calibration_report.allan_of
-
-    def counted(*args: Any, **kwargs: Any) -> Any:
-        calls.append(1)
-        return real(*args, **kwargs)
-
-    monkeypatch.setattr(calibration_report, "allan_of", counted)
-    log = _log(tmp_path)
-    plain = _run(log, tmp_path / "plain", capsys)
+    calls = count_allan_calls(monkeypatch)
+    log = px4_sweep_log(tmp_path / "s.ulg", 6000, 0.1, 41)
+    plain = run_json("px4-tempcal", log, tmp_path / "plain", capsys)
     assert calls == []  # nothing of the Allan section computed
-    asked = _run(log, tmp_path / "asked", capsys, "--allan")
+    asked = run_json("px4-tempcal", log, tmp_path / "asked", capsys, "--allan")
     assert len(calls) == 2 * 3 * 2  # two sensors, three axes, before and after
     for name in ("report_sensor_gyro_0.html", "report_sensor_accel_0.html"):
         without = (tmp_path / "plain" / name).read_text()

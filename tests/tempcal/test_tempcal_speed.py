@@ -13,30 +13,17 @@ import numpy as np
 import pytest
 
 import thermocal.tempcal.pipeline as pipeline
+from fc_sweeps import px4_sweep_log
 from thermocal import adequacy
 from thermocal.errors import ThermocalWarning
 from thermocal.recording import Metadata
 from thermocal.report.analysis import figures_of_merit, shown_figures
 from thermocal.report.sensor import write_sensor_report
 from thermocal.tempcal.px4 import px4_tempcal
-from ulog_writer import SENSOR_FIELDS, ulog_bytes
 
 
 def _log(tmp_path: Path, n: int = 6000) -> Path:
-    rng = np.random.default_rng(3)
-    t = np.arange(n) * 0.03
-    temp = -10.0 + 60.0 * (0.5 - 0.5 * np.cos(np.pi * t / t[-1]))
-    x = (temp - 20.0) / 30.0
-    g = np.column_stack([0.002 + 0.004 * x, -0.003 * x, 0.006 * x**2])  # [rad/s]
-    a = np.column_stack([0.05 + 0.08 * x, -0.06 * x, -9.80665 + 0.1 * x])  # [m/s²]
-    g, a = g + rng.normal(0, 1e-4, (n, 3)), a + rng.normal(0, 2e-3, (n, 3))
-    ts = (1e6 + t * 1e6).astype(np.int64)
-    rows_g = [(int(s), 7, *map(float, v), float(T)) for s, v, T in zip(ts, g, temp, strict=True)]
-    rows_a = [(int(s), 8, *map(float, v), float(T)) for s, v, T in zip(ts, a, temp, strict=True)]
-    log = tmp_path / "s.ulg"
-    log.write_bytes(ulog_bytes([("sensor_gyro", 0, SENSOR_FIELDS, rows_g),
-                                ("sensor_accel", 0, SENSOR_FIELDS, rows_a)]))  # fmt: skip
-    return log
+    return px4_sweep_log(tmp_path / "s.ulg", n, 0.03, 3)
 
 
 def test_stillness_is_computed_once_per_sensor(

@@ -1,7 +1,10 @@
 """Write the two flight-controller logs of the tutorial ``fc-params.md``: ``sweep.ulg`` (PX4
 ULog: ``sensor_gyro`` and ``sensor_accel``, instance 0) and ``sweep.bin`` (ArduPilot DataFlash:
 ``IMU`` instance 0), the same board swept from −10 to +50 °C in 50 minutes, still, with
-known cubic gyro and accelerometer biases, white noise and a few spikes.
+known cubic gyro and accelerometer biases, white noise and a few spikes; and ``heated.ulg``, a
+board whose heater holds its IMU at 55 °C (``SENS_EN_THERMAL`` 1, ``SENS_IMU_TEMP`` 55): boot
+at 15 °C, the heater's ramp, its overshoot and a 15-minute hold, one sample a second
+(``tests/helpers/fc_logs.py``'s ``heated_truth``, seed 7).
 
 Deterministic (NumPy's PCG64, seed 40): rerunning it rewrites the same bytes, which the test
 suite checks.  The file writers are the test suite's own (``tests/helpers/ulog_writer.py``,
@@ -22,6 +25,7 @@ HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE.parents[2] / "tests" / "helpers"))
 
 from dataflash_writer import imu_log  # noqa: E402
+from fc_logs import heated_truth, heated_ulog  # noqa: E402
 from ulog_writer import SENSOR_FIELDS, ulog_bytes  # noqa: E402
 
 G0 = 9.80665
@@ -78,6 +82,13 @@ def dataflash() -> bytes:
     return imu_log(rows)
 
 
+def heated() -> bytes:
+    """The heated board's ULog (PX4's heater parameters in its header)."""
+    truth = heated_truth(7, rate_hz=1.0)
+    return heated_ulog(truth, {"SENS_EN_THERMAL": 1, "SENS_IMU_TEMP": 55.0})
+
+
 if __name__ == "__main__":
+    (HERE / "heated.ulg").write_bytes(heated())
     (HERE / "sweep.ulg").write_bytes(ulog())
     (HERE / "sweep.bin").write_bytes(dataflash())

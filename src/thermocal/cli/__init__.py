@@ -39,6 +39,7 @@ COMMANDS: dict[str, str] = {
     "ardupilot-tempcal": "tempcal_cmd",
     "turntable": "turntable_cmd",
     "multipos": "multipos_cmd",
+    "ratetable": "ratetable_cmd",
     "report": "report_cmd",
     "fleet": "fleet_cmd",
     "demo": "demo_cmd",
@@ -136,7 +137,9 @@ def main(argv: list[str] | None = None) -> int:
     """Run the command line; returns the exit status (0 ok, 2 bad input, 1 internal).
 
     Usage errors (unknown option, missing argument) print one ``error: ...`` line
-    on stderr and return 2, as the common rules of the command line ask.
+    on stderr and return 2, as the common rules of the command line ask.  A group run
+    without a command (``thermocal``, ``thermocal station``) prints its help on stdout and
+    returns 0, as ``--help`` does, on every click and typer version.
 
     Parameters
     ----------
@@ -159,6 +162,9 @@ def main(argv: list[str] | None = None) -> int:
     except (typer.Abort, KeyboardInterrupt):  # click turns Ctrl-C into Abort
         return report_interrupted()
     except _USAGE_ERRORS as exc:
+        if type(exc).__name__ == "NoArgsIsHelpError":  # a group run alone: its help, as --help
+            print(exc.ctx.get_help())  # type: ignore[attr-defined]
+            return 0
         code = int(getattr(exc, "exit_code", 2))
         text = str(getattr(exc, "format_message", exc.__str__)())
         message = " ".join(text.split()) or "missing command or argument"

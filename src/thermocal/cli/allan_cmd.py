@@ -49,6 +49,7 @@ if TYPE_CHECKING:
     import thermocal.stability.registry as _registry
     import thermocal.stability.total as _total
     import thermocal.writers as _writers
+    from thermocal.recording import Recording
 else:
     _large = LazyModule("thermocal.pipeline.large")
     _writers = LazyModule("thermocal.writers")
@@ -130,7 +131,18 @@ TausOpt = Annotated[
     str, typer.Option("--taus", help="Tau set: octave, decade, log, or a list '1,10,100' [s].")
 ]
 PlotOpt = Annotated[Path | None, typer.Option("--plot", help="Write a log-log PNG plot here.")]
-HiddenTempsOpt = Annotated[str | None, typer.Option("--temps", hidden=True)]
+HiddenTempsOpt = Annotated[
+    str | None,
+    typer.Option("--temps", help="Temperature column: with --temp-bins, the terms per bin."),
+]
+AllanTempBinsOpt = Annotated[
+    str | None,
+    typer.Option(
+        "--temp-bins",
+        help="With --temps: the noise terms (N, K, B with intervals) per temperature bin and "
+        "their trend against temperature; a bin width in °C (5) or the edges (10,25,40).",
+    ),
+]
 DeviationOpt = Annotated[
     str | None,
     typer.Option(
@@ -269,6 +281,7 @@ def allan_cmd(
     temp_unit: TempUnitOpt = None,
     temp_conversion: TempConversionOpt = None,
     temps: HiddenTempsOpt = None,
+    edges_c: AllanTempBinsOpt = None,
     t_names: NamesOpt = None,
     topic: TopicOpt = None,
     stamp: StampOpt = "header",
@@ -313,6 +326,7 @@ def allan_cmd(
             "--deviation": deviation, "--data-type": data_type, "--dynamic": dynamic,
             "--bias-correct": bias_correct, "--noise-type": noise_type,
             "--noise-id": noise_id, "--max-work": max_work, "--rate": t_rate,
+            "--temp-bins": edges_c,
         }  # fmt: skip
         if _streamed(file, stream, signal, others):
             _check_plot(plot, file)
@@ -330,6 +344,11 @@ def allan_cmd(
         # the Allan deviation uses the time and the signal only
         rec = check_recording(_readers.read_recording(file, read, keep_other=False), read)
     _check_plot(plot, file)
+    if edges_c is not None:
+        others = {"--deviation": deviation, "--dynamic": dynamic, "--noise-type": noise_type,
+                  "--data-type": None if data_type == "rate" else data_type}  # fmt: skip
+        _by_temperature(file, rec, signal, temps, (edges_c, plot, others), confidence, as_json)
+        return
     tau_spec = parse_taus(taus)
     devs = parse_deviations(deviation) if deviation is not None else None
     with _total_bar(devs):
@@ -347,6 +366,36 @@ def allan_cmd(
     if plot is not None:
         _write_plots(file, plot, res)
     _emit_allan(file, res, as_json, plot)
+
+
+def _by_temperature(
+    file: Path, rec: "Recording", signal: str | None, temps: str | None,
+    bins_plot: tuple[str, Path | None, Mapping[str, object]], confidence: float, as_json: bool,
+) -> None:  # fmt: skip
+    """``--temps COL --temp-bins …``: the noise terms per temperature bin (of the default
+    analysis: the options of the others refused)."""
+    from thermocal.cli.noise_temps import parse_bins
+    from thermocal.report.noise_text import noise_by_temperature_text
+    from thermocal.stability.noise_temperature import signals_by_temperature
+
+    if not temps:
+        raise ThermocalInputError("--temp-bins applies with --temps COLUMN (the thermometer)")
+    given = [k for k, v in bins_plot[2].items() if v is not None]
+    if given:
+        raise ThermocalInputError(
+            f"--temp-bins gives the noise terms per bin of the default analysis: drop "
+            f"{', '.join(given)}"
+        )
+    edges, width = parse_bins(bins_plot[0])
+    res = signals_by_temperature(
+        rec, split_names(signal) or [rec.signals[0]], (split_names(temps) or [""])[0], edges,
+        width_c=width, confidence=confidence, where=str(file),
+    )  # fmt: skip
+    if bins_plot[1] is not None:
+        from thermocal.report.noise_plots import plot_noise_by_temperature
+
+        plot_noise_by_temperature(res, bins_plot[1], title=f"{file.name}: noise per temperature")
+    emit(res.to_dict(), as_json, lambda: show(noise_by_temperature_text(str(file), res, None)))
 
 
 @contextlib.contextmanager

@@ -61,6 +61,10 @@ COMMAND_SUMMARIES: dict[str, str] = {
         "Accelerometer (and gyro) triad bias, scale factors and misalignments from "
         "hand-placed poses, without a"
     ),
+    "ratetable": (
+        "Gyro scale factor, nonlinearity, asymmetry, bias per rate, input threshold and "
+        "resolution from a rate-table"
+    ),
     "report": "Write a self-contained HTML report (figures embedded, no network needed).",
     "fleet": (
         "Calibrate every unit of a production batch: the [fit] options once, one "

@@ -455,3 +455,36 @@ def progress(description: str, total: float | None = None) -> Iterator[Callable[
     ) as bar:
         task = bar.add_task(description, total=total)
         yield lambda amount: bar.advance(task, amount)
+
+
+HeaterOpt = Annotated[
+    str,
+    typer.Option(
+        "--heater",
+        help="A heated IMU's hold at its set-point (within ±0.5 °C for 60 s): cut (fit the "
+        "sweep up to the set-point, the hold weighing no more than the sweep, and say the "
+        "range is cut), refuse (a range cut by the heater is an error) or ignore (no hold "
+        "looked for).",
+    ),
+]
+HeaterSetpointOpt = Annotated[
+    float | None,
+    typer.Option(
+        "--heater-setpoint",
+        help="The heater's set-point [°C] (default: the flight-controller log's "
+        "SENS_IMU_TEMP or BRD_HEAT_TARG in px4-tempcal and ardupilot-tempcal, else inferred "
+        "from the one plateau at the top of the temperature).",
+    ),
+]
+HeaterBandOpt = Annotated[
+    float,
+    typer.Option(
+        "--heater-band",
+        help="Half-width [°C] of the band a heater's hold stays in (default 0.5; 1 for a "
+        "thermometer that reads whole degrees).",
+    ),
+]
+HeaterMinHoldOpt = Annotated[
+    float,
+    typer.Option("--heater-min-hold", help="Shortest heater hold [s] (default 60)."),
+]

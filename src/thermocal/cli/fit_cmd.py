@@ -44,6 +44,10 @@ from thermocal.cli.common import (
     AxisOpt,
     DecimalOpt,
     DelimiterOpt,
+    HeaterBandOpt,
+    HeaterMinHoldOpt,
+    HeaterOpt,
+    HeaterSetpointOpt,
     JsonOpt,
     LatitudeOpt,
     NamesOpt,
@@ -305,7 +309,10 @@ _COMMON_LAST = (
     ("allow_narrow", AllowNarrowOpt, False), ("allow_motion", AllowMotionOpt, False),
     ("names", NamesOpt, None), ("topic", TopicOpt, None), ("rate", RateOpt, None),
     ("on_bad_lines", OnBadLinesOpt, "error"), ("delimiter", DelimiterOpt, None),
-    ("decimal", DecimalOpt, None), ("stamp", StampOpt, "header"), ("param", ParamOpt, None),
+    ("decimal", DecimalOpt, None), ("stamp", StampOpt, "header"),
+    ("heater", HeaterOpt, "cut"), ("heater_setpoint", HeaterSetpointOpt, None),
+    ("heater_band", HeaterBandOpt, 0.5), ("heater_min_hold", HeaterMinHoldOpt, 60.0),
+    ("param", ParamOpt, None),
     ("temperature", TemperatureModeOpt, "reconstructed"), ("as_json", JsonOpt, False),
 )  # fmt: skip
 """The options of ``fit`` every family shares, around the families' own."""

@@ -15,7 +15,6 @@ import typer
 from thermocal._lazy import LazyModule
 from thermocal.cli.application import app
 from thermocal.cli.common import JsonOpt, emit, handle_errors, progress, stdout
-from thermocal.errors import ThermocalInputError
 
 if TYPE_CHECKING:
     from thermocal.fleet import batch as _fleet
@@ -56,9 +55,7 @@ def fleet_cmd(
     output path is, or holds, one of the inputs, or is a special file."""
     cfg = _fleet.load_config(config)
     _fleet.check_workers(workers, scheduler)
-    _fleet.check_outputs(cfg, output)  # inputs are sacred: before anything is written
-    if output.exists() and not output.is_dir():
-        raise ThermocalInputError(f"{output}: exists and is not a directory")
+    # inputs are sacred: run_fleet refuses an output that is or holds one before writing
     n_workers = workers if workers is not None else max(1, min(os.cpu_count() or 1, len(cfg.units)))
     with progress("units", total=len(cfg.units)) as advance:
 

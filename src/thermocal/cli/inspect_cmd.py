@@ -95,6 +95,7 @@ def inspect_cmd(
         read,
         skipped=skipped,
         guess_temperatures=True,
+        columns_on_demand=True,  # inspected one at a time: one column held, not all
     )
     result = _inspection.inspect_recording(rec, skipped)
     emit(result.to_dict(option_name), as_json, lambda: _print_human(result))

@@ -139,7 +139,9 @@ def metrics_cmd(
             decimal=t_dec, stamp=stamp,
         )  # fmt: skip
         # metrics use the signal and the temperatures only
-        return check_recording(_readers.read_recording(file, r, keep_other=False), r)
+        # (each column read when used: the signal and one temperature held, not all)
+        rec = _readers.read_recording(file, r, keep_other=False, columns_on_demand=True)
+        return check_recording(rec, r)
 
     def options() -> "_metrics.MetricsOptions":
         t_names_ = split_names(temps)

@@ -8,6 +8,9 @@ from typing import TYPE_CHECKING, Annotated
 import typer
 
 from thermocal._lazy import LazyModule, prefetch
+from thermocal.cli import noise_psd as _psd_out
+from thermocal.cli import noise_sheet as _sheet
+from thermocal.cli import noise_temps as _temps
 from thermocal.cli.application import app
 from thermocal.cli.common import (
     ConfidenceOpt,
@@ -18,6 +21,7 @@ from thermocal.cli.common import (
     OnBadLinesOpt,
     RateOpt,
     StampOpt,
+    TempUnitOpt,
     TimeOpt,
     TimeUnitOpt,
     TopicOpt,
@@ -61,7 +65,19 @@ def _triad(text: str | None, option: str, taken: list[str] | None = None) -> lis
     return names
 
 
-GyroColsOpt = Annotated[str, typer.Option("--gyro", help="Gyro columns X,Y,Z.")]
+GyroColsOpt = Annotated[
+    str | None,
+    typer.Option("--gyro", help="Gyro columns X,Y,Z (required but with --from-datasheet)."),
+]
+FromDatasheetOpt = Annotated[
+    bool,
+    typer.Option(
+        "--from-datasheet",
+        help="FILE holds data-sheet figures (TOML: update_rate_hz = 200, gyro_noise_density = "
+        '"0.014 deg/s/sqrt(Hz)", accel_noise_density = "175 ug/sqrt(Hz)", gyro_random_walk or '
+        "gyro_bias_instability, the same for accel): the Kalibr file from them, units converted.",
+    ),
+]
 NoiseOutOpt = Annotated[Path, typer.Option("-o", "--output", help="Output file.")]
 AccelColsOpt = Annotated[str | None, typer.Option("--accel", help="Accelerometer columns X,Y,Z.")]
 GyroUnitOpt = Annotated[
@@ -79,6 +95,45 @@ InflateOpt = Annotated[
     float,
     typer.Option(
         "--inflate", help="Multiply every Kalibr noise value by this (≥ 1; stated in the file)."
+    ),
+]
+NoiseTempsOpt = Annotated[
+    str | None,
+    typer.Option(
+        "--temps",
+        help="Temperature column: the noise terms per temperature bin (--temp-bins), their "
+        "trend against temperature, and with --at-temperature the model at one temperature.",
+    ),
+]
+TempBinsOpt = Annotated[
+    str | None,
+    typer.Option(
+        "--temp-bins",
+        help="With --temps: a bin width in °C (default 5) or the edges (10,25,40,55).",
+    ),
+]
+AtTemperatureOpt = Annotated[
+    float | None,
+    typer.Option(
+        "--at-temperature",
+        help="With --temps: the model at this temperature [°C], each axis interpolated "
+        "between the bins around it, with the inflation the record supports.",
+    ),
+]
+NoisePlotOpt = Annotated[
+    Path | None,
+    typer.Option(
+        "--plot",
+        help="With --temps: a PNG of N, K and B per bin against temperature, with their "
+        "intervals and significant trends.",
+    ),
+]
+PsdOpt = Annotated[
+    Path | None,
+    typer.Option(
+        "--psd",
+        help="Also the PSD (Welch, one-sided, data unit/√Hz) of every axis, written to this "
+        "CSV; its white level beside the Allan deviation's, and where the two disagree.",
     ),
 ]
 RostopicOpt = Annotated[str, typer.Option("--rostopic", help="Kalibr's rostopic of this IMU.")]
@@ -99,12 +154,37 @@ def _unit_list(
     return tuple([gyro_unit] * n_g + [accel_unit or ""] * n_a)
 
 
+def _check_temps_options(
+    file: Path,
+    output: Path,
+    temps: str | None,
+    others: tuple[object, object, Path | None, Path | None],
+) -> None:
+    """``--temp-bins``, ``--at-temperature`` and ``--plot`` need ``--temps``; ``--psd`` is
+    of the whole record; the plot is neither an input nor ``-o``."""
+    edges_c, temperature_c, plot, psd = others
+    if temps is None and (edges_c is not None or temperature_c is not None or plot is not None):
+        raise ThermocalInputError(
+            "--temp-bins, --at-temperature and --plot apply with --temps COLUMN (the IMU's "
+            "thermometer)"
+        )
+    if temps is not None and psd is not None:
+        raise ThermocalInputError(
+            "--psd is of the whole record: run it without --temps (the bins' white levels "
+            "are in the --temps table)"
+        )
+    if plot is not None:
+        _writers.check_not_input(plot, [file])
+        if plot.resolve() == output.resolve() or plot.is_dir():
+            raise ThermocalInputError(f"--plot {plot}: give a PNG file name other than -o")
+
+
 @app.command("noise")
 @handle_errors
 def noise_cmd(
     file: FileArg,
-    gyro: GyroColsOpt,
     output: NoiseOutOpt,
+    gyro: GyroColsOpt = None,
     accel: AccelColsOpt = None,
     gyro_unit: GyroUnitOpt = None,
     accel_unit: AccelUnitOpt = None,
@@ -121,6 +201,13 @@ def noise_cmd(
     t_bad: OnBadLinesOpt = "error",
     t_delim: DelimiterOpt = None,
     t_dec: DecimalOpt = None,
+    from_datasheet: FromDatasheetOpt = False,
+    temps: NoiseTempsOpt = None,
+    temp_unit: TempUnitOpt = None,
+    edges_c: TempBinsOpt = None,
+    temperature_c: AtTemperatureOpt = None,
+    psd: PsdOpt = None,
+    plot: NoisePlotOpt = None,
 ) -> None:
     """IMU noise model for estimators: per axis the white-noise density (the −½ line of
     the Allan deviation at τ = 1 s) and the random walk (+½ line at τ = 3 s, or the
@@ -129,6 +216,17 @@ def noise_cmd(
     prefetch("scipy.special", "scipy.linalg", "rich.table")
     if out_format not in ("kalibr", "json"):
         raise ThermocalInputError(f"--format {out_format!r}: use kalibr or json")
+    if from_datasheet:
+        given = {"--gyro": gyro, "--accel": accel, "--temps": temps, "--psd": psd, "--plot": plot}
+        _sheet.refuse_recording_options(given)
+        _sheet.from_datasheet(file, output, out_format, inflate=inflate, rostopic=rostopic)
+        return
+    _check_temps_options(file, output, temps, (edges_c, temperature_c, plot, psd))
+    if gyro is None:
+        raise ThermocalInputError(
+            "give the gyro columns with --gyro X,Y,Z (or --from-datasheet with a file of "
+            "data-sheet figures)"
+        )
     g_names = _triad(gyro, "--gyro")
     a_names = _triad(accel, "--accel", g_names)
     if out_format == "kalibr" and not a_names:
@@ -137,13 +235,16 @@ def noise_cmd(
             "(or --format json for the gyro alone)"
         )
     _writers.check_not_input(output, [file])
+    if psd is not None:
+        _psd_out.check(psd, file, output)
     if output.is_dir():
         raise ThermocalInputError(f"{output}: is a directory, expected a file name")
     read = read_options(
         time=time, time_unit=time_unit, signal=",".join(g_names + a_names),
         signal_unit=_unit_list(gyro_unit, accel_unit, len(g_names), len(a_names)),
         topic=topic, names=t_names, rate=t_rate, on_bad_lines=t_bad, delimiter=t_delim,
-            decimal=t_dec, stamp=stamp,
+            decimal=t_dec, stamp=stamp, temp_unit=temp_unit,
+            **({"temps": temps} if temps is not None else {}),
     )  # fmt: skip
     rec = _readers.read_recording(
         file,
@@ -153,6 +254,11 @@ def noise_cmd(
                    **dict.fromkeys(a_names, "accel_unit")},
     )  # fmt: skip
     check_recording(rec, read)
+    if temps is not None:
+        opts = {"out_format": out_format, "temperature_c": temperature_c, "inflate": inflate,
+                "rostopic": rostopic, "confidence": confidence, "plot": plot}  # fmt: skip
+        _temps.by_temperature(file, rec, (g_names, a_names), temps, edges_c, opts, output)
+        return
     res = _analysis.imu_noise(
         rec, g_names, a_names, inflate=inflate, rostopic=rostopic, confidence=confidence,
         where=str(file),
@@ -165,4 +271,6 @@ def noise_cmd(
         fh.write(text + ("" if text.endswith("\n") else "\n"))
 
     show(_text.imu_noise_text(str(file), res))
+    if psd is not None:
+        _psd_out.write(rec, res.model.axes, psd)
     stdout.print(f"{out_format} noise model written to {output} (per sensor the largest axis)")

@@ -16,6 +16,10 @@ from thermocal.cli.application import app
 from thermocal.cli.common import (
     AllowMotionOpt,
     AllowNarrowOpt,
+    HeaterBandOpt,
+    HeaterMinHoldOpt,
+    HeaterOpt,
+    HeaterSetpointOpt,
     JsonOpt,
     emit,
     handle_errors,
@@ -26,6 +30,7 @@ from thermocal.defaults import overrides_of
 from thermocal.report import firmware_text as _firmware_text
 
 if TYPE_CHECKING:
+    from thermocal.heater import HeaterOptions
     from thermocal.tempcal.ardupilot import ArdupilotTempcalResult
     from thermocal.tempcal.px4 import Px4TempcalResult
     from thermocal.tempcal.thermometers import TempsFrom
@@ -47,6 +52,15 @@ TempsFromOpt = Annotated[
         help="Calibrate against another thermometer, joined by time: N (IMU instance N's), "
         "baro (the first barometer's); TARGETS=SOURCE for some instances only, e.g. 0=1 or "
         "0,2=baro (default: every instance its own).",
+    ),
+]
+EmulateOpt = Annotated[
+    bool,
+    typer.Option(
+        "--emulate-learning",
+        help="Also run the firmware's own temperature learning on the log's samples, as its "
+        "source defines it: would it have completed, why not, what it would store against "
+        "thermocal's fit (and, for ArduPilot, its TCLR points against the log's).",
     ),
 ]
 
@@ -98,6 +112,16 @@ def _temperature_mode(text: str) -> "Literal['reconstructed', 'raw']":
     return "raw" if low == "raw" else "reconstructed"
 
 
+def heater_options(
+    heater: str, setpoint: float | None, band: float, min_hold: float
+) -> "HeaterOptions":
+    """``--heater``, ``--heater-setpoint``, ``--heater-band`` and ``--heater-min-hold`` as
+    the library's options."""
+    from thermocal.heater import HeaterOptions
+
+    return HeaterOptions(heater, setpoint, band, min_hold)  # type: ignore[arg-type]
+
+
 M_MMAP_THRESHOLD = -3
 """glibc's ``mallopt`` parameter of the size from which a block is a mapping of its own."""
 
@@ -138,6 +162,11 @@ def px4_tempcal_cmd(
             "gyro and accelerometer reports (slower on a long log).",
         ),
     ] = False,
+    heater: HeaterOpt = "cut",
+    heater_setpoint: HeaterSetpointOpt = None,
+    heater_band: HeaterBandOpt = 0.5,
+    heater_min_hold: HeaterMinHoldOpt = 60.0,
+    emulate_learning: EmulateOpt = False,
     temperature: TemperatureOpt = "reconstructed",
     temps_from: TempsFromOpt = None,
 ) -> None:
@@ -151,7 +180,8 @@ def px4_tempcal_cmd(
 
     res = px4_tempcal(
         log, output, tref_c=tref, overrides=overrides_of(allow_narrow, allow_motion),
-        reporter=write_sensor_report, allan=allan,
+        reporter=write_sensor_report, allan=allan, emulate_learning=emulate_learning,
+        heater=heater_options(heater, heater_setpoint, heater_band, heater_min_hold),
         temperature=_temperature_mode(temperature), temps_from=parse_temps_from(temps_from),
     )  # fmt: skip
     emit(res.to_dict(), as_json, lambda: _print_px4(res))
@@ -159,6 +189,10 @@ def px4_tempcal_cmd(
 
 def _print_px4(res: "Px4TempcalResult") -> None:
     show(_firmware_text.px4_tempcal_text(res))
+    if res.emulated_learning:
+        from thermocal.report.learning_text import px4_learning_text
+
+        show(px4_learning_text(res.emulated_learning))
     stdout.print(f"parameters: [bold]{res.params_path}[/bold]", markup=True)
 
 
@@ -178,6 +212,11 @@ def ardupilot_tempcal_cmd(
             "gyro and accelerometer reports (slower on a long log).",
         ),
     ] = False,
+    heater: HeaterOpt = "cut",
+    heater_setpoint: HeaterSetpointOpt = None,
+    heater_band: HeaterBandOpt = 0.5,
+    heater_min_hold: HeaterMinHoldOpt = 60.0,
+    emulate_learning: EmulateOpt = False,
     temperature: TemperatureOpt = "reconstructed",
     temps_from: TempsFromOpt = None,
 ) -> None:
@@ -191,7 +230,8 @@ def ardupilot_tempcal_cmd(
 
     res = ardupilot_tempcal(
         log, output, overrides=overrides_of(allow_narrow, allow_motion),
-        reporter=write_sensor_report, allan=allan,
+        reporter=write_sensor_report, allan=allan, emulate_learning=emulate_learning,
+        heater=heater_options(heater, heater_setpoint, heater_band, heater_min_hold),
         temperature=_temperature_mode(temperature), temps_from=parse_temps_from(temps_from),
     )  # fmt: skip
     emit(res.to_dict(), as_json, lambda: _print_ardupilot(res))
@@ -199,4 +239,8 @@ def ardupilot_tempcal_cmd(
 
 def _print_ardupilot(res: "ArdupilotTempcalResult") -> None:
     show(_firmware_text.ardupilot_tempcal_text(res))
+    if res.emulated_learning:
+        from thermocal.report.learning_text import ardupilot_learning_text
+
+        show(ardupilot_learning_text(res.emulated_learning))
     stdout.print(f"parameters: [bold]{res.params_path}[/bold]", markup=True)

@@ -6,6 +6,9 @@ formats     the firmware dialects (:data:`~thermocal.firmware.formats.FORMATS`)
 binning     temperature bins (medians of 0.5 °C bins) and the hold-out split
 px4         :func:`~thermocal.firmware.px4.px4_coefficients` (``TC_*``)
 ardupilot   :func:`~thermocal.firmware.ardupilot.ardupilot_coefficients` (``INS_TCAL*``)
+learning    the firmware's own learning emulated on a log's samples:
+            :func:`~thermocal.firmware.learning.ardupilot_learning`,
+            :func:`~thermocal.firmware.learning.px4_oncal`
 ==========  ==========================================================================
 """
 

@@ -947,6 +947,7 @@ def summary_rows(
     out_dir: Path,
     redone: Mapping[str, str] | None = None,
     stale: Mapping[str, str] | None = None,
+    records: Mapping[str, dict[str, Any] | None] | None = None,
 ) -> list[dict[str, Any]]:
     """One row per unit of the configuration, from the units' ``unit.json`` (a unit with
     none, or found stale and not redone (``stale``: an interrupted run): ``status``
@@ -962,6 +963,8 @@ def summary_rows(
         Units redone in this run and why.
     stale : mapping, optional
         Units found stale and not redone (pending).
+    records : mapping, optional
+        The units' ``unit.json`` already read (:func:`read_unit`, by id); None: read here.
 
     Returns
     -------
@@ -971,7 +974,7 @@ def summary_rows(
     redone = redone or {}
     stale = stale or {}
     for u in config.units:
-        rec = read_unit(out_dir, u.id)
+        rec = records[u.id] if records is not None else read_unit(out_dir, u.id)
         row: dict[str, Any] = {"id": u.id}
         if rec is None or u.id in stale:
             why = "not run yet" if rec is None else f"to be redone: {stale[u.id]}"
@@ -1428,10 +1431,13 @@ def run_fleet(
     ------
     ThermocalInputError
         An output is, or holds, an input (:func:`check_outputs`, before anything is
-        written); the scheduler's address is not one.
+        written); the output exists and is not a directory; the scheduler's address is
+        not one.
     """
     out = Path(out_dir)
     check_outputs(config, out)
+    if out.exists() and not out.is_dir():
+        raise ThermocalInputError(f"{out}: exists and is not a directory")
     run = executor or (dask_executor(scheduler) if scheduler else local_executor(workers))
     out.mkdir(parents=True, exist_ok=True)
     _clean_stale(out / "units")
@@ -1488,9 +1494,10 @@ def _finish(
     done = set(ran)
     redone = {k: v for k, v in redo.items() if k in done}
     stale = {k: v for k, v in redo.items() if k not in done}
-    rows = summary_rows(config, out, redone, stale)
+    read = {u.id: read_unit(out, u.id) for u in config.units}  # each unit.json read once
+    rows = summary_rows(config, out, redone, stale, read)
     csv_path, pq_path = write_summary(rows, out)
-    records = {u.id: (None if u.id in stale else read_unit(out, u.id)) for u in config.units}
+    records = {uid: (None if uid in stale else rec) for uid, rec in read.items()}
     html = write_fleet_report(out / "fleet.html", config, records, redone=redone)
     return rows, csv_path, pq_path, html
 

@@ -32,6 +32,7 @@ import numpy.typing as npt
 from thermocal import units
 from thermocal.errors import DesignError, ThermocalInputError, ThermocalWarning
 from thermocal.multipos import accel as _accel
+from thermocal.multipos import gsens as _gsens
 from thermocal.multipos import gyro as _gyro
 from thermocal.multipos.geometry import attitude_along
 from thermocal.multipos.poses import FACES, Section, detect_poses
@@ -251,6 +252,12 @@ class SessionResult:
         Mean temperature [°C].
     not_still : tuple of str
         Poses whose variance is more than twice the quietest's.
+    g_sensitivity : GSensitivity or None
+        The gyro's sensitivity to specific force from the static poses
+        (:func:`thermocal.multipos.gsens.fit_g_sensitivity`; None without a gyro or when the
+        poses cannot separate it).
+    g_sensitivity_note : str or None
+        Why it is None with a gyro (the poses it would need).
     """
 
     accel: _accel.AccelFit
@@ -260,14 +267,18 @@ class SessionResult:
     g_mg: float
     temperature_c: float | None
     not_still: tuple[str, ...] = field(default=())
+    g_sensitivity: _gsens.GSensitivity | None = None
+    g_sensitivity_note: str | None = None
 
     def to_dict(self) -> dict[str, Any]:
         """The session's calibration as plain JSON types: ``accel`` and ``gyro``
         (:meth:`AccelFit.to_dict <thermocal.multipos.accel.AccelFit.to_dict>`,
         :meth:`GyroFit.to_dict <thermocal.multipos.gyro.GyroFit.to_dict>`, None without a
         gyro), ``g_mg`` [mg], ``temperature_c`` [°C], ``poses`` (:meth:`poses_dict`),
-        ``turns`` (name, start, end) and ``not_still``."""
-        return {
+        ``turns`` (name, start, end), ``not_still`` and, with a gyro, ``g_sensitivity``
+        (:meth:`GSensitivity.to_dict <thermocal.multipos.gsens.GSensitivity.to_dict>` in
+        °/h/g, None when the poses cannot separate it) and ``g_sensitivity_note`` (why)."""
+        out: dict[str, Any] = {
             "accel": self.accel.to_dict(),
             "gyro": None if self.gyro is None else self.gyro.to_dict(),
             "g_mg": self.g_mg,
@@ -276,6 +287,11 @@ class SessionResult:
             "turns": [{"name": s.name, "start": s.start, "end": s.end} for s in self.turns],
             "not_still": list(self.not_still),
         }
+        if self.gyro is not None:
+            gs = self.g_sensitivity
+            out["g_sensitivity"] = None if gs is None else gs.to_dict()
+            out["g_sensitivity_note"] = self.g_sensitivity_note
+        return out
 
     def table(self) -> list[dict[str, Any]]:
         """Every coefficient of the session as rows (triad, parameter, value, sigma,
@@ -537,6 +553,50 @@ def _accel_fit(
     return acc, idx
 
 
+def _mean_over(x: npt.ArrayLike, sections: Sequence[Section]) -> float:
+    """The mean of ``x`` over the samples of ``sections`` (NaN left out)."""
+    v = np.asarray(x, dtype=np.float64)
+    return float(np.nanmean(np.concatenate([v[s.start : s.end] for s in sections])))
+
+
+def _calibrated_up(
+    stats: Sequence[PoseStats], acc: _accel.AccelFit, idx: Sequence[int]
+) -> tuple[Any, FloatArray, FloatArray]:
+    """The up direction of each pose as a function of the accelerometer's free θ, those
+    θ and their covariance."""
+    f = np.asarray([p.f_mean_mg for p in stats])
+    names = [p.section.name for p in stats]
+    held = np.array([acc.method == "six-face" and n in FACES for n in names])
+    up_of = _up_function(acc.theta, idx, f, held)
+    free = acc.theta[np.asarray(idx)]
+    free_cov = acc.cov[np.ix_(np.asarray(idx), np.asarray(idx))]
+    return up_of, free, free_cov
+
+
+def _pose_rates(stats: Sequence[PoseStats]) -> tuple[FloatArray, FloatArray, FloatArray]:
+    """Samples per pose, each pose's mean rate [rad/s] and the rate's white-noise σ [rad/s]
+    (the poses' σ pooled by their samples)."""
+    n = np.asarray([p.section.n for p in stats], dtype=np.float64)
+    wm = np.asarray([p.w_mean_rad_s for p in stats])
+    ws = np.sqrt(np.average(np.asarray([p.w_sigma_rad_s for p in stats]) ** 2, axis=0,
+                            weights=n))  # fmt: skip
+    return n, wm, ws
+
+
+def _g_sensitivity(
+    stats: Sequence[PoseStats], acc: _accel.AccelFit, idx: Sequence[int], g_mg: float,
+    latitude_deg: float | None,
+) -> tuple[_gsens.GSensitivity | None, str | None]:  # fmt: skip
+    """The gyro's g-sensitivity from the static poses (:mod:`.gsens`), or None and why."""
+    up_of, free, _cov = _calibrated_up(stats, acc, idx)
+    n, wm, ws = _pose_rates(stats)
+    try:
+        gs = _gsens.fit_g_sensitivity(wm, n, ws, up_of(free) * g_mg / 1000.0, latitude_deg)
+    except DesignError as exc:
+        return None, str(exc)
+    return gs, None
+
+
 def _gyro_fit(
     t: FloatArray, a: FloatArray, w: FloatArray, stats: Sequence[PoseStats],
     turns: Sequence[Section], acc: _accel.AccelFit, idx: Sequence[int], g_mg: float,
@@ -544,18 +604,11 @@ def _gyro_fit(
     where: str, sections_from: str,
 ) -> _gyro.GyroFit:  # fmt: skip
     """The gyro fit of :func:`calibrate_session`, on the accelerometer's up directions."""
-    f = np.asarray([p.f_mean_mg for p in stats])
     sig = np.asarray([p.mean_sigma_mg for p in stats])
     names = [p.section.name for p in stats]
-    held = np.array([acc.method == "six-face" and n in FACES for n in names])
-    up_of = _up_function(acc.theta, idx, f, held)
-    free = acc.theta[np.asarray(idx)]
-    free_cov = acc.cov[np.ix_(np.asarray(idx), np.asarray(idx))]
+    up_of, free, free_cov = _calibrated_up(stats, acc, idx)
     up = up_of(free)
-    n = np.asarray([p.section.n for p in stats], dtype=np.float64)
-    wm = np.asarray([p.w_mean_rad_s for p in stats])
-    ws = np.sqrt(np.average(np.asarray([p.w_sigma_rad_s for p in stats]) ** 2, axis=0,
-                            weights=n))  # fmt: skip
+    n, wm, ws = _pose_rates(stats)
     bias, bias_cov = _gyro.static_bias(wm, n, ws, up, latitude_deg)
     dt = np.diff(t)
     dt = np.concatenate([dt, dt[-1:]])
@@ -613,7 +666,7 @@ def calibrate_session(
     Returns
     -------
     SessionResult
-        The accelerometer and gyro fits, the poses and turns; ``to_dict()``, ``table()``.
+        The accelerometer and gyro fits (and the gyro's g-sensitivity), the poses and turns.
 
     Raises
     ------
@@ -662,16 +715,15 @@ def calibrate_session(
             "poses",
         )
     acc, idx = _accel_fit(stats, g_mg, where, sections_from)
-    temp = None
-    if temperature_c is not None:
-        tc = np.asarray(temperature_c, dtype=np.float64)
-        temp = float(np.nanmean(np.concatenate([tc[s.start : s.end] for s in statics])))
-    gfit = None
+    temp = None if temperature_c is None else _mean_over(temperature_c, statics)
+    gfit, gsens, gnote = None, None, None
     if w is not None:
         sat = None if saturated is None else np.asarray(saturated, dtype=bool)
         gfit = _gyro_fit(t, a, w, stats, turns, acc, idx, g_mg, latitude_deg, sat,
                          gyro_model, where, sections_from)  # fmt: skip
-    return SessionResult(acc, gfit, tuple(stats), tuple(turns), g_mg, temp, not_still)
+        gsens, gnote = _g_sensitivity(stats, acc, idx, g_mg, latitude_deg)
+    return SessionResult(acc, gfit, tuple(stats), tuple(turns), g_mg, temp, not_still,
+                         gsens, gnote)  # fmt: skip
 
 
 @dataclass(frozen=True)

@@ -112,6 +112,7 @@ def simulate_session(
     tremor_deg: float = 0.003,
     latitude_deg: float = 45.0,
     max_angle_deg: float = 170.0,
+    g_sensitivity_deg_h_g: FloatArray | None = None,
 ) -> dict[str, Any]:
     """One session (module docstring): ``time_s``, ``accel_mg`` (n, 3), ``gyro_deg_s``
     (n, 3), the true ``attitude`` (n, 3, 3, body → local), ``poses`` (start, end) of the
@@ -137,6 +138,8 @@ def simulate_session(
         Latitude for the earth rate [°].
     max_angle_deg : float, default 170.0
         Largest rotation between consecutive poses [°] (the smallest is 30°).
+    g_sensitivity_deg_h_g : numpy.ndarray, shape (3, 3), optional
+        The gyro's sensitivity to specific force [°/h per g] (:func:`simulate_attitudes`).
 
     Returns
     -------
@@ -165,7 +168,8 @@ def simulate_session(
     return simulate_attitudes(rng, cs, accel_theta, gyro_theta, rate_hz=rate_hz,
                               dwell_s=dwell_s, move_s=move_s, accel_noise_mg=accel_noise_mg,
                               gyro_noise_deg_s=gyro_noise_deg_s, tremor_deg=tremor_deg,
-                              latitude_deg=latitude_deg)  # fmt: skip
+                              latitude_deg=latitude_deg,
+                              g_sensitivity_deg_h_g=g_sensitivity_deg_h_g)  # fmt: skip
 
 
 def simulate_attitudes(
@@ -181,6 +185,7 @@ def simulate_attitudes(
     gyro_noise_deg_s: float = 0.03,
     tremor_deg: float = 0.003,
     latitude_deg: float = 45.0,
+    g_sensitivity_deg_h_g: FloatArray | None = None,
 ) -> dict[str, Any]:
     """A session through the given still ``attitudes`` (body → local ENU rotations, each
     move shorter than a half turn), as :func:`simulate_session` (which draws them at
@@ -204,6 +209,9 @@ def simulate_attitudes(
         Amplitude of the hand's tremor while still [°].
     latitude_deg : float, default 45.0
         Latitude for the earth rate [°].
+    g_sensitivity_deg_h_g : numpy.ndarray, shape (3, 3), optional
+        The gyro's sensitivity to specific force ``A`` (row: gyro axis, column: the specific
+        force's axis) [°/h per g] (:mod:`thermocal.multipos.gsens`); None: none.
 
     Returns
     -------
@@ -213,7 +221,8 @@ def simulate_attitudes(
     spec = _Spec(rate_hz, dwell_s, move_s, tremor_deg, 6.0)
     w_nb, poses, _turns = _body_rates(rng, attitudes, {}, spec)
     return _measure(rng, attitudes[0], w_nb, poses, accel_theta, gyro_theta,
-                    accel_noise_mg, gyro_noise_deg_s, latitude_deg, rate_hz)  # fmt: skip
+                    accel_noise_mg, gyro_noise_deg_s, latitude_deg, rate_hz,
+                    g_sensitivity_deg_h_g)  # fmt: skip
 
 
 FERRARIS_TURNS: dict[str, tuple[str, float]] = {
@@ -288,6 +297,7 @@ def simulate_ferraris(
     tremor_deg: float = 0.003,
     latitude_deg: float = 45.0,
     order: str = "faces-then-turns",
+    g_sensitivity_deg_h_g: FloatArray | None = None,
 ) -> dict[str, Any]:
     """A Ferraris session (imucal's form): the six faces ``x_p``, ``y_p``, ``z_p``, ``x_a``,
     ``y_a``, ``z_a`` in that order (no flip to the opposite face: a half turn; random
@@ -326,6 +336,8 @@ def simulate_ferraris(
         Amplitude of the hand's tremor while still [°].
     latitude_deg : float, default 45.0
         Latitude for the earth rate [°].
+    g_sensitivity_deg_h_g : numpy.ndarray, shape (3, 3), optional
+        The gyro's sensitivity to specific force [°/h per g] (:func:`simulate_attitudes`).
 
     Returns
     -------
@@ -361,7 +373,7 @@ def simulate_ferraris(
     spec = _Spec(rate_hz, dwell_s, move_s, tremor_deg, turn_s, turn_tilt_deg)
     w_nb, poses, turns = _body_rates(rng, cs, turn_after, spec)
     out = _measure(rng, cs[0], w_nb, poses, accel_theta, gyro_theta, accel_noise_mg,
-                   gyro_noise_deg_s, latitude_deg, rate_hz)  # fmt: skip
+                   gyro_noise_deg_s, latitude_deg, rate_hz, g_sensitivity_deg_h_g)  # fmt: skip
     sections = {f: {"start": a, "end": b} for f, (a, b) in zip(faces, poses, strict=False)}
     for k, (a, b) in turns.items():
         sections[FERRARIS_TURNS[at[k]][0]] = {"start": a, "end": b}
@@ -449,8 +461,10 @@ def _measure(
     gyro_noise_deg_s: float,
     latitude_deg: float,
     rate_hz: float,
+    g_sensitivity: FloatArray | None = None,
 ) -> dict[str, Any]:
-    """The attitude from the body rate, and what the triads read (module docstring)."""
+    """The attitude from the body rate, and what the triads read (module docstring); the
+    gyro's bias moves by ``g_sensitivity`` [°/h per g] times the true specific force."""
     dt = 1.0 / rate_hz
     n = w_nb.shape[0]
     d = attitude_along(np.vstack([w_nb, np.zeros((1, 3))]), np.full(n + 1, dt))
@@ -475,6 +489,8 @@ def _measure(
     accel = f_true @ (np.eye(3) + e_a).T + accel_theta[0:3]
     accel += rng.normal(0, accel_noise_mg, size=accel.shape)
     gyro = w_true @ (np.eye(3) + e_g).T + gyro_theta[0:3] * units.DH_TO_RS
+    if g_sensitivity is not None:  # specific force in g (standard gravity: 1000 mg)
+        gyro += (f_true / 1000.0) @ np.asarray(g_sensitivity).T * units.DH_TO_RS
     gyro = gyro * units.RAD_TO_DEG + rng.normal(0, gyro_noise_deg_s, size=gyro.shape)
     return {
         "time_s": np.arange(n + 1) * dt,

@@ -864,7 +864,10 @@ def fit_files(paths: Sequence[Path], options: FitOptions, output: Path) -> FitRe
             f"{{name}} applies to the poly family (coefficients about TREF), not {o.model!r}",
         )
     _distinct_runs([path for path, _rec in loaded])
+    # the thermometer first: the heater's hold is judged (and thinned) on the temperature
+    # the fit uses, and the reconstruction needs every sample (its update period)
     loaded, thermo = _thermometers(loaded, o)
+    loaded, holds, said = _heater_holds(loaded, o)
     spec = _FitSpec(o.model, family_options, o.temperatures, o.latitude, o.axis, o.known_input,
                     o.target, o.gravity_axis, g_local, o.tref,
                     _gravity.triad_gravity(loaded, names, o.gravity_axis, g_local),
@@ -873,8 +876,9 @@ def fit_files(paths: Sequence[Path], options: FitOptions, output: Path) -> FitRe
         est, result, n_runs = _fit_channel(spec, loaded, names[0] if names else None)
         est.inputs_ = {**(est.inputs_ or {}), "thermometers": _recorded(thermo)}
         _files.save_model(est, output)
-        result["output"] = str(output)
+        result["output"], result["heater"] = str(output), holds
         result["thermometers"] = thermo
+        result["warnings"] = [*said, *result["warnings"]]
         return FitResult(output, (FittedChannel(est.signal_name, est, result, n_runs),), False)
     fitted = _fit_channels(spec, loaded, names)
     for _name, est, _res, _n in fitted:
@@ -892,10 +896,35 @@ def fit_files(paths: Sequence[Path], options: FitOptions, output: Path) -> FitRe
         ]
     )
     _files.save_calibration(cal, output)
+    extra = {"heater": holds, "thermometers": thermo}
     channels = tuple(
-        FittedChannel(name, est, {**res, "thermometers": thermo}, n) for name, est, res, n in fitted
+        FittedChannel(name, est, {**res, **extra, "warnings": [*said, *res["warnings"]]}, n)
+        for name, est, res, n in fitted
     )
     return FitResult(output, channels, True)
+
+
+def _heater_holds(
+    loaded: list[tuple[Path, _recording.Recording]], o: FitOptions
+) -> tuple[list[tuple[Path, _recording.Recording]], dict[str, Any], list[str]]:
+    """Each run's heater hold (:func:`thermocal.heater.thin_recording`) thinned to its
+    sweep's density; the holds found by file name (JSON) and their warnings, also said."""
+    from thermocal.heater import HeaterOptions, HeaterWarning, thin_recording
+
+    heater = HeaterOptions(o.heater, o.heater_setpoint, o.heater_band, o.heater_min_hold)  # type: ignore[arg-type]
+    if o.model == "warmup" and o.heater_setpoint is None:  # its plateau is what it models
+        return loaded, {}, []
+    temp = (o.temperatures or (None,))[0]
+    out, holds, said = [], {}, []
+    for path, rec in loaded:
+        thinned, judged = thin_recording(rec, heater, where=str(path), temperature=temp)
+        for text in judged.warnings:
+            warnings.warn(HeaterWarning(text), stacklevel=3)
+            said.append(text)
+        if judged.hold is not None:
+            holds[path.name] = judged.hold.to_dict()
+        out.append((path, thinned))
+    return out, holds, said
 
 
 __all__ = [

@@ -217,15 +217,15 @@ def _plan(path: Path, read: ReadOptions, signal: str | None) -> _Plan:
             "column; drop {rate_hz}",
             "rate_hz",
         )
-    obj, info = dispatch._open_table(path, read)
+    obj, info = dispatch.open_table(path, read)
     pf = pq.ParquetFile(path)
     opts = UnitOptions(read.time_unit, read.signal_unit, read.temp_unit, read.temp_conversion)
-    head = dispatch._table_recording(
+    head = dispatch.table_recording(
         path, _HeadColumns(pf, HEAD_ROWS), info, read, opts, meta=None, keep_other=False,
         skipped=None, stated=None, guess_temperatures=False,
     )  # fmt: skip
     del obj
-    time_col, _sigs, _temps = dispatch._roles(
+    time_col, _sigs, _temps = dispatch.column_roles(
         path, list(pf.schema_arrow.names), info, read.time, read.signals, read.temperatures, False
     )
     if not head.signals:
@@ -543,7 +543,7 @@ def metrics_streamed(
         )
     canon = plan.head.signal(plan.signal)[1]
     unit, k = mt.data_unit_of(plan.head, plan.signal, canon)
-    earth = mt._earth_rate(
+    earth = mt.earth_rate_to_remove(
         plan.head, plan.signal, canon, unit, k, options.latitude_deg, options.axis
     )
     share = 0.6

@@ -205,6 +205,8 @@ OPTION_OF: dict[str, str] = {
     "models": "--model",
     "validations": "--validation",
     "labels": "--label",
+    "rates_dps": "--rates",
+    "width_c": "--temp-bins",
 }
 """Library parameters whose command-line option is not the parameter's name with dashes
 (``time_unit`` → ``--time-unit`` needs no entry)."""

@@ -49,10 +49,15 @@ def file_sha256(path: str | Path, chunk: int = 1 << 20) -> str:
     ----------
     - FIPS PUB 180-4, Secure Hash Standard (SHS), NIST, 2015.
     """
+    from thermocal.readers.common import sha256_of
     from thermocal.readers.station import is_station_path, station_files
 
-    h = hashlib.sha256()
     p = Path(path)
+    if p.is_file():  # a plain file: its digest taken once per process while it is unchanged
+        digest = sha256_of(p)
+        if digest is not None:
+            return digest
+    h = hashlib.sha256()
     # a station's recording folder (DIR or DIR/SENSOR): its closed parts, in order; another
     # folder a format reads (a ROS 2 bag): its files by name
     files = [p] if not p.is_dir() else sorted(f for f in p.iterdir() if f.is_file())

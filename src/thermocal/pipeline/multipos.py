@@ -734,7 +734,10 @@ def _summary(
                           "direction_rms_before_deg": math.degrees(
                               r.gyro.direction_rms_before_rad),
                           "direction_rms_after_deg": math.degrees(
-                              r.gyro.direction_rms_after_rad)}  # fmt: skip
+                              r.gyro.direction_rms_after_rad),
+                          "g_sensitivity": None if r.g_sensitivity is None
+                          else r.g_sensitivity.to_dict(to_g, str(g_unit)),
+                          "g_sensitivity_note": r.g_sensitivity_note}  # fmt: skip
         all_before.append(r.accel.residual_rms_before_mg**2 * len(r.poses))
         all_after.append(r.accel.residual_rms_after_mg**2 * len(r.poses))
         run_dicts.append(rd)

@@ -98,6 +98,16 @@ class FitOptions:
     stamp : {"header", "receive"}
         Time of a ROS bag's messages: their header stamp (default) or the bag's receive
         time.
+    heater : {"cut", "refuse", "ignore"}
+        A heated sensor's hold at its set-point (:class:`thermocal.heater.HeaterPolicy`):
+        thinned to the sweep's density with the cut range said (default), refused, or
+        not looked for.
+    heater_setpoint : float, optional
+        The heater's set-point [°C]; default inferred from the one plateau at the top of
+        the first temperature column after a 10 °C sweep (never for the warmup family,
+        whose plateau is what it models).
+    heater_band, heater_min_hold : float
+        The hold's half-width [°C] (default 0.5) and shortest duration [s] (default 60).
     temperature : {"reconstructed", "raw"}
         A quantised or slow thermometer (:mod:`thermocal.thermometer`: a lattice of 0.1 °C or
         more, or updated every second or slower) fitted on the temperature reconstructed at
@@ -106,7 +116,9 @@ class FitOptions:
     Raises
     ------
     thermocal.errors.ParameterError
-        A target, column list or temperature conversion no fit can use, naming the field.
+        A target, column list, temperature conversion, heater policy or temperature mode no
+        fit can use,
+        naming the field.
 
     Examples
     --------
@@ -144,6 +156,10 @@ class FitOptions:
     delimiter: str | None = None
     decimal: Literal[".", ","] | None = None
     stamp: Literal["header", "receive"] = "header"
+    heater: Literal["cut", "refuse", "ignore"] = "cut"
+    heater_setpoint: float | None = None
+    heater_band: float = 0.5
+    heater_min_hold: float = 60.0
     temperature: Literal["reconstructed", "raw"] = "reconstructed"
 
     def __post_init__(self) -> None:
@@ -152,6 +168,19 @@ class FitOptions:
             raise ParameterError(
                 "temperature", f"{{name}} must be reconstructed or raw, got {self.temperature!r}"
             )
+        if self.heater not in ("cut", "refuse", "ignore"):
+            raise ParameterError(
+                "heater", f"{{name}} must be cut, refuse or ignore, got {self.heater!r}"
+            )
+        sp = self.heater_setpoint
+        if sp is not None and not -273.15 < sp < float("inf"):
+            raise ParameterError(
+                "heater_setpoint",
+                f"{{name}} must be a finite temperature above −273.15 °C, got {sp}",
+            )
+        for name in ("heater_band", "heater_min_hold"):
+            if not 0.0 < getattr(self, name) < float("inf"):
+                raise ParameterError(name, f"{{name}} must be positive, got {getattr(self, name)}")
         for field in ("signals", "temperatures", "names"):
             set_(self, field, _names(getattr(self, field), field))
         if self.temp_conversion is not None:

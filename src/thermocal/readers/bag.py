@@ -59,6 +59,17 @@ _MIN_MESSAGE = 16  # bytes of the smallest message a bag can hold (a header with
 _NS = 1_000_000_000
 
 
+def _definitions_before_iron() -> Any:
+    """The message definitions to read a ROS 2 bag that stores none: rosbag2 writes them
+    into its storage from ROS 2 Iron (2023) on; a bag recorded with Foxy, Galactic or Humble
+    holds only the type names.  ``sensor_msgs/Imu`` and ``sensor_msgs/Temperature`` (and the
+    ``std_msgs/Header`` they carry) are the same in every ROS 2 release, so Humble's set
+    reads them; a bag that carries its own definitions is read with those."""
+    from rosbags.typesys import Stores, get_typestore
+
+    return get_typestore(Stores.ROS2_HUMBLE)
+
+
 def _needs_rosbags(path: Path) -> Any:
     """The ``rosbags`` package, or one error naming the extra that installs it."""
     try:
@@ -235,10 +246,23 @@ def _pick(path: Path, conns: list[Any], topic: str | None) -> tuple[str, str | N
             "topic",
         )
     if not names:
-        if len(imus) != 1:
-            what = "no sensor_msgs/Imu topic" if not imus else "several sensor_msgs/Imu topics"
+        if not imus and temps:
             raise MissingColumnError.naming(
-                f"{path}: {what}; choose one with {{topic}}; it has: {have}", "topic"
+                f"{path}: no sensor_msgs/Imu topic; choose a sensor_msgs/Temperature topic "
+                f"with {{topic}} to read it alone; it has: {have}",
+                "topic",
+            )
+        if not imus:
+            raise MissingColumnError(
+                f"{path}: no sensor_msgs/Imu topic (thermocal reads sensor_msgs/Imu and "
+                f"sensor_msgs/Temperature topics; record the IMU as sensor_msgs/Imu); "
+                f"it has: {have}"
+            )
+        if len(imus) > 1:
+            raise MissingColumnError.naming(
+                f"{path}: several sensor_msgs/Imu topics; choose one with {{topic}}; "
+                f"it has: {have}",
+                "topic",
             )
         names = imus[:1]
     for i, n in enumerate(names):
@@ -276,7 +300,7 @@ def _scan(path: Path, topic: str | None) -> tuple[dict[str, _Series], str, str |
     """One pass over the bag: the chosen topics' stamps and values."""
     highlevel = _needs_rosbags(path)
     try:
-        reader = highlevel.AnyReader([path])
+        reader = highlevel.AnyReader([path], default_typestore=_definitions_before_iron())
         reader.open()
     except Exception as exc:  # rosbags raises several kinds on a damaged bag
         raise FileFormatError(_unreadable(path, exc)) from None

@@ -398,7 +398,7 @@ def _parm(
 
 
 def dataflash_table(
-    log: DataflashLog, path: Path, name: str, inst: int
+    log: DataflashLog, path: Path, name: str, inst: int, fields: Sequence[str] | None = None
 ) -> tuple[pd.DataFrame, dict[str, Any]]:
     """Instance ``inst`` of message ``name`` from a :func:`read_dataflash_log` pass, as a
     table with the firmware's units (:data:`ARDUPILOT_UNITS`).  Both layouts: the instance
@@ -415,6 +415,10 @@ def dataflash_table(
         Message name (``IMU``).
     inst : int
         Instance (0-based).
+    fields : sequence of str, optional
+        The fields wanted: the table holds those of them the message has (``TimeUS``
+        always); None (default): every field.  A caller that reads a few fields of a long
+        message spares the float64 copy of the others.
 
     Returns
     -------
@@ -430,8 +434,9 @@ def dataflash_table(
         Messages without ``TimeUS`` (a damaged format definition).
     """
     legacy = f"{name}{inst + 1}" if inst > 0 else None  # IMU2 = IMU.1 in older logs
+    keep = None if fields is None else {"TimeUS", *fields}
     if name in log.columns or (legacy is not None and legacy in log.columns):
-        df, source = _columns_table(log, name, legacy, inst)
+        df, source = _columns_table(log, name, legacy, inst, keep)
     else:
         rows = [r for r in log.rows.get(name, []) if int(r.get("I", 0)) == inst]
         source = name
@@ -439,6 +444,8 @@ def dataflash_table(
             rows = [r for r in log.rows.get(legacy, []) if "I" not in r]
             source = legacy
         df = pd.DataFrame(rows).astype(np.float64) if rows else None
+        if df is not None and keep is not None:
+            df = df[[c for c in df.columns if c in keep]]
     if df is None:
         raise MissingColumnError(
             f"{path}: no {name} messages of instance {inst} in the log"
@@ -467,11 +474,11 @@ def dataflash_table(
 
 
 def _columns_table(
-    log: DataflashLog, name: str, legacy: str | None, inst: int
+    log: DataflashLog, name: str, legacy: str | None, inst: int, keep: set[str] | None = None
 ) -> tuple[pd.DataFrame | None, str]:
     """:func:`dataflash_table`'s selection from :attr:`DataflashLog.columns`: the messages
     ``name`` of instance ``inst`` (no ``I`` field: instance 0), else those of ``legacy``
-    without an ``I`` field; (None, name) when there are none."""
+    without an ``I`` field; (None, name) when there are none; ``keep``: only these fields."""
     cols = log.columns.get(name)
     if cols is not None:
         inst_col = cols.get("I")
@@ -479,19 +486,24 @@ def _columns_table(
             whole = np.trunc(inst_col) if inst_col.dtype.kind == "f" else inst_col
             rows = np.flatnonzero(whole == inst)
             if rows.size:
-                return _frame(cols, rows), name
+                return _frame(_kept(cols, keep), rows), name
         elif inst == 0 and len(next(iter(cols.values()))):
-            return _frame(cols, None), name
+            return _frame(_kept(cols, keep), None), name
     old = log.columns.get(legacy) if legacy is not None else None
     if old is not None and "I" not in old and len(next(iter(old.values()))):
-        return _frame(old, None), str(legacy)
+        return _frame(_kept(old, keep), None), str(legacy)
     return None, name
+
+
+def _kept(cols: dict[str, npt.NDArray[Any]], keep: set[str] | None) -> dict[str, npt.NDArray[Any]]:
+    """The columns named in ``keep`` (None: all), in the message's order."""
+    return cols if keep is None else {k: v for k, v in cols.items() if k in keep}
 
 
 def _frame(cols: dict[str, npt.NDArray[Any]], rows: npt.NDArray[np.intp] | None) -> pd.DataFrame:
     """The columns (those ``rows``; None: all) as one float64 frame, gathered straight into
     the frame's block (fields × rows, no second copy)."""
-    n = len(next(iter(cols.values()))) if rows is None else rows.size
+    n = len(next(iter(cols.values()), ())) if rows is None else rows.size
     block = np.empty((len(cols), n))
     for j, v in enumerate(cols.values()):
         block[j] = v if rows is None else v[rows]  # float64 on the way in

@@ -9,7 +9,7 @@ import re
 import warnings
 from collections.abc import Mapping, Sequence
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, cast
 
 from thermocal import units
 from thermocal._lazy import LazyModule
@@ -32,7 +32,13 @@ from thermocal.readers.common import (
 from thermocal.readers.formats import TEXT_FIELDS, FileFormat, format_of, registered_formats
 from thermocal.readers.options import ReadOptions
 from thermocal.readers.station import is_station_path
-from thermocal.readers.table import ParquetColumns, load_sidecar, numeric_column
+from thermocal.readers.table import (
+    ON_DEMAND_MIN_COLUMNS,
+    ColumnsOnDemand,
+    ParquetColumns,
+    load_sidecar,
+    numeric_column,
+)
 from thermocal.readers.text import counter_column, counter_time, rate_time
 from thermocal.recording import (
     META_FORMAT,
@@ -175,10 +181,32 @@ def _fc_log_unknown_units(
         )
 
 
-def _open_table(p: Path, read: ReadOptions) -> tuple[pd.DataFrame | ParquetColumns, dict[str, Any]]:
+def open_table(p: Path, read: ReadOptions) -> tuple[pd.DataFrame | ParquetColumns, dict[str, Any]]:
     """The table of a file (its registered format chooses the reader) or of a station's
     recording folder (``DIR`` or ``DIR/SENSOR``), and what the file and its sidecar say of
-    it.  A FIFO, device or socket is refused before it is opened, a plain directory named."""
+    it.  A FIFO, device or socket is refused before it is opened, a plain directory named.
+
+    Parameters
+    ----------
+    p : Path
+        The file or folder.
+    read : ReadOptions
+        How it is read (a log's topic, a text layout).
+
+    Returns
+    -------
+    table : pandas.DataFrame or ParquetColumns
+        The table (a Parquet file's columns are read when asked for).
+    info : dict
+        What the file's metadata and its sidecar state (units, roles, metadata).
+
+    Raises
+    ------
+    thermocal.errors.FileFormatError
+        No registered format reads it, or a folder that is not a station's recording.
+    thermocal.errors.ThermocalInputError
+        An option the format does not take (``topic``, ``stamp``).
+    """
     refuse_special_input(p)
     fmt = format_of(p) if not p.is_dir() or is_station_path(p) else None
     if fmt is None and p.is_dir():  # a folder another format recognises (a ROS 2 bag)
@@ -248,6 +276,15 @@ def _read_other_columns(
     for c in names:
         if c in cols:
             continue
+        lazy: Any = cols  # a numeric column of a file read on demand: read when asked for
+        if (
+            isinstance(lazy, ColumnsOnDemand)
+            and isinstance(obj, ParquetColumns)
+            and obj.is_numeric(c)
+        ):
+            lazy.add(c)
+            unit_map[c] = units.other_column_unit(c, extra_units.get(c))
+            continue
         try:
             cols[c] = numeric_column(obj, c, p)
         except NonNumericError:
@@ -312,7 +349,7 @@ TIME_HINT_PARAMETERS: tuple[str, ...] = ("time", "rate_hz")
 """The parameters a :func:`time_hint` names."""
 
 
-def _roles(
+def column_roles(
     p: Path,
     names: list[str],
     info: dict[str, Any],
@@ -324,7 +361,33 @@ def _roles(
     """The time, signal and temperature columns: as given, else as the file or its
     sidecar says (else, with ``guess_temperatures``, the columns named like temperatures,
     :func:`~thermocal.readers.common.named_like_temperature`); a name the file does not have is
-    refused, listing the available ones."""
+    refused, listing the available ones.
+
+    Parameters
+    ----------
+    p : Path
+        The file, named in errors.
+    names : list of str
+        The file's columns.
+    info : dict
+        What the file and its sidecar state (:func:`open_table`).
+    time, signals, temperatures : optional
+        The columns given (``ReadOptions.time``, ``.signals``, ``.temperatures``).
+    guess_temperatures : bool, optional
+        No temperatures given or stated: take those named like one.
+
+    Returns
+    -------
+    time_col : str
+        The time column.
+    sig_names, tmp_names : list of str
+        The signal and the temperature columns.
+
+    Raises
+    ------
+    thermocal.errors.MissingColumnError
+        A column the file does not have (the available ones listed).
+    """
     time_col = time or default_time_column(names, info.get("time"))
     sig_info: dict[str, str] = dict(info.get("signals") or {})
     tmp_info: dict[str, str] = dict(info.get("temperatures") or {})
@@ -353,16 +416,27 @@ def _roles(
 def _read_columns(
     p: Path,
     obj: pd.DataFrame | ParquetColumns,
-    n_rows: int,
-    n_used: int,
+    size: tuple[int, int],
     time_col: str,
     named: list[str],
+    on_demand: bool = False,
 ) -> tuple[FloatArray, dict[str, FloatArray]]:
     """The time column (in the file's unit) and the ``named`` columns as float64; a Parquet
     file is read column by column, only these, once its ``n_used`` columns of ``n_rows``
-    are known to fit in memory."""
+    (``size``) are known to fit in memory; ``on_demand``: its numeric columns read when
+    asked for (:class:`ColumnsOnDemand`), three columns' memory needed at most."""
     if isinstance(obj, ParquetColumns):  # read column by column: only what is used
-        check_memory(p, n_rows, n_used)
+        n_rows, n_used = size  # on demand: time and two columns held at a time
+        check_memory(p, n_rows, min(n_used, ON_DEMAND_MIN_COLUMNS) if on_demand else n_used)
+        if on_demand:
+            lazy = ColumnsOnDemand(obj, p)
+            t = numeric_column(obj, time_col, p)
+            for c in named:
+                if obj.is_numeric(c):
+                    lazy.add(c)
+                else:  # read now: a non-numeric cell is refused as by a whole read
+                    lazy[c] = numeric_column(obj, c, p)
+            return t, cast("dict[str, FloatArray]", lazy)
         obj.read_f64([time_col, *named])
     t = numeric_column(obj, time_col, p)
     return t, {c: numeric_column(obj, c, p) for c in named}
@@ -483,6 +557,7 @@ def read_recording(
     guess_temperatures: bool = False,
     ask_units: dict[str, str] | None = None,
     implied_units: dict[str, str] | None = None,
+    columns_on_demand: bool = False,
 ) -> Recording:
     """Read a recording from any registered file format into a :class:`Recording`.
 
@@ -519,6 +594,9 @@ def read_recording(
         Signal column → the parameter a :class:`~thermocal.errors.UnitError` asks for
         (``"accel_unit"``), or the unit another parameter implies (``counts``: a count
         scale), where nothing states its unit (:class:`thermocal.units.UnitOptions`).
+    columns_on_demand : bool, optional
+        A Parquet file's columns read at each use, one held at a time, when more than
+        :data:`~thermocal.readers.table.ON_DEMAND_MIN_COLUMNS` are used (time included).
 
     Returns
     -------
@@ -552,15 +630,15 @@ def read_recording(
     """
     p = Path(path)
     r = read or ReadOptions()
-    obj, info = _open_table(p, r)
+    obj, info = open_table(p, r)
     stated, fitted = _stated_by_model(model)
     units_of = units.UnitOptions(  # the options' own; a rate's counter is in s (below)
         r.time_unit, r.signal_unit, r.temp_unit, r.temp_conversion,
         dict(ask_units or {}), dict(implied_units or {}),
     )  # fmt: skip
-    rec = _table_recording(
+    rec = table_recording(
         p, obj, info, r, units_of, meta=meta, keep_other=keep_other, skipped=skipped,
-        stated=stated, guess_temperatures=guess_temperatures,
+        stated=stated, guess_temperatures=guess_temperatures, columns_on_demand=columns_on_demand,
     )  # fmt: skip
     if fitted is not None:
         from thermocal.models.rundata import check_sensor_id
@@ -569,7 +647,7 @@ def read_recording(
     return rec
 
 
-def _table_recording(
+def table_recording(
     p: Path,
     obj: pd.DataFrame | ParquetColumns,
     info: dict[str, Any],
@@ -581,9 +659,33 @@ def _table_recording(
     skipped: list[str] | None,
     stated: units.StatedUnits | None,
     guess_temperatures: bool,
+    columns_on_demand: bool = False,
 ) -> Recording:
     """The :class:`Recording` of a table read from ``p``: roles, units resolved once, time in
-    seconds (a rate's rows, counter or stamps), the other numeric columns kept."""
+    seconds (a rate's rows, counter or stamps), the other numeric columns kept.
+
+    Parameters
+    ----------
+    p : Path
+        The file.
+    obj : pandas.DataFrame or ParquetColumns
+        Its table (:func:`open_table`).
+    info : dict
+        What the file and its sidecar state.
+    r : ReadOptions
+        How it is read.
+    options : thermocal.units.UnitOptions
+        The units given.
+    meta, keep_other, skipped, stated, guess_temperatures
+        As for :func:`read_recording` (``stated``: the units a model states).
+    columns_on_demand : bool, optional
+        As for :func:`read_recording`.
+
+    Returns
+    -------
+    Recording
+        Time [s], the columns as float64, their units and roles, the metadata.
+    """
     names = list(obj.column_names) if isinstance(obj, ParquetColumns) else list(obj.columns)
     time, time_unit = r.time, r.time_unit
     mode = None  # rate_hz: "rows", "counter" or "stamps" (rate_time)
@@ -593,13 +695,16 @@ def _table_recording(
     md = Metadata.from_dict(dict(info.get("metadata") or {}))
     if meta is not None:
         md = md.merged(meta)
-    time_col, sig_names, tmp_names = _roles(
+    time_col, sig_names, tmp_names = column_roles(
         p, names, info, time, r.signals, r.temperatures, guess_temperatures
     )
     options = dataclasses.replace(options, time_unit="s" if mode == "counter" else time_unit)
     resolved = _resolve_units(p, info, (time_col, sig_names, tmp_names), options, meta, stated)
     n_used = len(names) if keep_other else 1 + len(sig_names) + len(tmp_names)
-    t, cols = _read_columns(p, obj, n_rows, n_used, time_col, [*sig_names, *tmp_names])
+    t, cols = _read_columns(
+        p, obj, (n_rows, n_used), time_col, [*sig_names, *tmp_names],
+        columns_on_demand and n_used > ON_DEMAND_MIN_COLUMNS,
+    )  # fmt: skip
     t = _time_s(p, time_col, t, resolved.time.unit, mode, r)
     unit_map: dict[str, str] = resolved.units()
     md.temperature_conversion = _conversions(md, tmp_names, resolved)

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import json
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterator, MutableMapping, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -141,6 +141,23 @@ class ParquetColumns:
         if pos == self.num_rows:
             self._read.update(out)
 
+    def is_numeric(self, name: str) -> bool:
+        """Whether the column ``name`` is stored as integers or floating-point numbers.
+
+        Parameters
+        ----------
+        name : str
+            The column's name (one of :attr:`column_names`).
+
+        Returns
+        -------
+        bool
+            True for an integer or floating-point column (read as float64 by
+            :meth:`column_f64`).
+        """
+        field_type = self._pf.schema_arrow.field(name).type
+        return bool(pa.types.is_integer(field_type) or pa.types.is_floating(field_type))
+
     def column(self, name: str) -> pa.ChunkedArray:
         """One column as Arrow, read whole.
 
@@ -180,7 +197,9 @@ class ParquetColumns:
         out = np.empty(self.num_rows, dtype=np.float64)
         pos = 0
         for i in range(self._pf.num_row_groups):
-            col = self._pf.read_row_group(i, columns=[name]).column(0)
+            # one column: no threads to share it among (on a loaded machine they halve
+            # the speed)
+            col = self._pf.read_row_group(i, columns=[name], use_threads=False).column(0)
             for chunk in col.chunks:
                 k = len(chunk)
                 out[pos : pos + k] = arrow_chunk_f64(chunk)  # nulls → NaN
@@ -190,6 +209,95 @@ class ParquetColumns:
         if pos != self.num_rows:
             raise pa.ArrowInvalid(f"column {name!r} has {pos} rows, the file {self.num_rows}")
         return out
+
+
+ON_DEMAND_MIN_COLUMNS = 3
+"""Columns used (time included) up to which a Parquet file is read whole even where its
+columns could be read on demand (:class:`ColumnsOnDemand`): time and two columns are what
+reading on demand holds at a time anyway, and every use would read a column again."""
+
+
+class ColumnsOnDemand(MutableMapping[str, FloatArray]):
+    """The numeric columns of a Parquet file, each read as float64 when it is asked for
+    and not kept beyond the next one: a recording's columns for a command that uses them
+    one at a time (``inspect``, ``metrics``), so that its memory is the time axis and one
+    or two columns whatever the number of columns.
+
+    The values are those :meth:`ParquetColumns.column_f64` reads (the same as a whole
+    read); a column assigned to the mapping is kept as given.  The order of the names is
+    the order they were added in, as for a dict.
+
+    Parameters
+    ----------
+    source : ParquetColumns
+        The open file.
+    path : Path
+        The file, named in errors.
+
+    Examples
+    --------
+    >>> import tempfile, pathlib
+    >>> import pyarrow as pa, pyarrow.parquet as pq
+    >>> f = pathlib.Path(tempfile.mkdtemp()) / "r.parquet"
+    >>> pq.write_table(pa.table({"t": [0.0, 1.0], "g": [1.5, 2.5]}), f)
+    >>> cols = ColumnsOnDemand(ParquetColumns(pq.ParquetFile(f)), f)
+    >>> cols.add("g")
+    >>> list(cols), cols["g"].tolist()
+    (['g'], [1.5, 2.5])
+    """
+
+    def __init__(self, source: ParquetColumns, path: Path) -> None:
+        self._source, self._path = source, path
+        self._names: list[str] = []
+        self._given: dict[str, FloatArray] = {}
+        self._last: tuple[str, FloatArray] | None = None
+
+    def add(self, name: str) -> None:
+        """Name a numeric column of the file as one of the mapping's (read when asked for).
+
+        Parameters
+        ----------
+        name : str
+            The column (integer or floating point in the file).
+        """
+        if name not in self._names:
+            self._names.append(name)
+
+    def __getitem__(self, name: str) -> FloatArray:
+        if name in self._given:
+            return self._given[name]
+        if name not in self._names:
+            raise KeyError(name)
+        if self._last is not None and self._last[0] == name:
+            return self._last[1]
+        self._last = None  # the previous column released before the next is read
+        values = numeric_column(self._source, name, self._path)
+        self._last = (name, values)
+        return values
+
+    def __setitem__(self, name: str, values: FloatArray) -> None:
+        self.add(name)
+        self._given[name] = values
+
+    def __delitem__(self, name: str) -> None:
+        if name not in self._names:
+            raise KeyError(name)
+        self._names.remove(name)
+        self._given.pop(name, None)
+        if self._last is not None and self._last[0] == name:
+            self._last = None
+
+    def __iter__(self) -> Iterator[str]:
+        return iter(list(self._names))
+
+    def __len__(self) -> int:
+        return len(self._names)
+
+    def __contains__(self, name: object) -> bool:
+        return name in self._names
+
+    def __repr__(self) -> str:
+        return f"ColumnsOnDemand({self._path}, {self._names!r})"
 
 
 def csv_header_names(path: Path, encoding: str) -> list[str]:

@@ -53,7 +53,9 @@ def write_sensor_report(path: Path, req: AnyReportRequest) -> None:
             recording_path=req.recording_path, title=req.title, sensor=req.sensor,
             generated_by=req.generated_by, extra=req.extra, notes=req.notes,
             appendix=tuple(
-                comparison_html(c) for c in (req.previous, req.firmware_learning) if c is not None
+                comparison_html(c)
+                for c in (req.previous, req.firmware_learning, req.emulated_learning)
+                if c is not None
             ),
             allan=req.allan,
         ),

@@ -67,6 +67,46 @@ def gyro_misfit_line(run: dict[str, Any]) -> str | None:
     )
 
 
+def g_sensitivity_line(run: dict[str, Any]) -> str | None:
+    """The gyro's sensitivity to specific force found in a run's static poses: the elements
+    beyond 3σ with their σ (or that none is), or why the poses cannot separate it; None
+    without a gyro.
+
+    Parameters
+    ----------
+    run : dict
+        One run of a multi-position result's ``runs`` (its ``gyro`` figures).
+
+    Returns
+    -------
+    str or None
+
+    References
+    ----------
+    IEEE Std 952-1997, annex B (acceleration-sensitive drift).
+    """
+    g = run.get("gyro")
+    if not g or "g_sensitivity" not in g:
+        return None
+    gs = g["g_sensitivity"]
+    if gs is None:
+        return f"{run['input']}: gyro g-sensitivity not estimated: {g['g_sensitivity_note']}"
+    found = [
+        f"{'xyz'[i]}/{'xyz'[j]} {fmt(gs['matrix'][i][j], 3)} ± {fmt(gs['matrix_sigma'][i][j], 2)}"
+        for i in range(3)
+        for j in range(3)
+        if gs["significant"][i][j]
+    ]
+    head = (
+        f"{run['input']}: gyro g-sensitivity from {gs['n_poses']} poses "
+        f"[{gs['unit']}, gyro/force axis]: "
+    )
+    if not found:
+        worst = max(max(row) for row in gs["matrix_sigma"])
+        return head + f"none beyond 3σ (σ ≤ {fmt(worst, 2)})"
+    return head + "; ".join(found) + " (beyond 3σ; not compensated by this calibration)"
+
+
 def pose_detection_lines(out: dict[str, Any]) -> list[str]:
     """The pose detector's choice, per file: poses found, the still limit and what set it,
     the stretches rejected and why.
@@ -161,6 +201,8 @@ def multipos_summary_text(out: dict[str, Any], a_unit: str, output: Path | str) 
     )
     for run in out["runs"]:
         line = gyro_misfit_line(run)
+        blocks += [line] if line is not None else []
+        line = g_sensitivity_line(run)
         blocks += [line] if line is not None else []
         if run["accel"].get("misfit"):
             blocks.append(

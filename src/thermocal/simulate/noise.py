@@ -43,6 +43,12 @@ class NoiseParams:
         R [u/s].
     resolution : float
         Output LSB [u] (0: none); pulse outputs are quantized by the scale factor instead.
+    white_density_per_c : float
+        Relative change of N per °C [1/°C] (0: none): at temperature T the white-noise
+        density is ``N·(1 + white_density_per_c·(T − white_reference_c))`` (a MEMS
+        sensor's noise grows with temperature), when the temperature is given.
+    white_reference_c : float
+        The temperature at which the density is N [°C] (default 25).
 
     Notes
     -----
@@ -68,6 +74,8 @@ class NoiseParams:
     rate_random_walk: float = 0.0
     rate_ramp: float = 0.0
     resolution: float = 0.0
+    white_density_per_c: float = 0.0
+    white_reference_c: float = 25.0
 
 
 def flicker_noise(n: int, dt_s: float, b: float, rng: np.random.Generator) -> FloatArray:
@@ -131,7 +139,13 @@ FLICKER_MAX_RATE_HZ = 10.0
 """Flicker noise is synthesised at this rate at most (held constant within each block)."""
 
 
-def simulate_noise(n: int, dt_s: float, noise: NoiseParams, rng: np.random.Generator) -> FloatArray:
+def simulate_noise(
+    n: int,
+    dt_s: float,
+    noise: NoiseParams,
+    rng: np.random.Generator,
+    temperature_c: npt.ArrayLike | None = None,
+) -> FloatArray:
     r"""The noise of a sensor output: white, flicker, rate random walk and rate ramp.
 
     White noise of standard deviation N/√τ0 per sample, flicker (:func:`flicker_noise`,
@@ -148,6 +162,9 @@ def simulate_noise(n: int, dt_s: float, noise: NoiseParams, rng: np.random.Gener
         The noise terms N, B, K, R.
     rng : numpy.random.Generator
         The source of the random numbers.
+    temperature_c : array_like, optional
+        The sensor's temperature at each sample [°C]: the white noise's density follows it
+        by ``noise.white_density_per_c`` (ignored when that is 0).
 
     Returns
     -------
@@ -185,6 +202,9 @@ def simulate_noise(n: int, dt_s: float, noise: NoiseParams, rng: np.random.Gener
     if noise.white_density:
         out = rng.standard_normal(n)
         out *= noise.white_density / math.sqrt(dt_s)
+        if noise.white_density_per_c and temperature_c is not None:
+            dt_c = np.asarray(temperature_c, dtype=np.float64) - noise.white_reference_c
+            out *= np.maximum(1.0 + noise.white_density_per_c * dt_c, 0.0)
     else:
         out = np.zeros(n)
     if noise.bias_instability:

@@ -735,6 +735,65 @@ def scenario_multipos(seed: int, profile: ProfileInput = None, **opts: Any) -> S
     return [(rec, _plain({"scenario": "multipos", "seed": int(seed), **t})) for rec, t in runs]
 
 
+RATETABLE_ERRORS: dict[str, float] = {
+    "scale_factor": 1.0,
+    "quadratic_ppm": 30.0,
+    "cubic_ppm": 150.0,
+    "asymmetry_ppm": 200.0,
+    "bias_dps": 0.02,
+    "tc_ppm_per_c": 40.0,
+    "dead_zone_dps": 0.015,
+}
+"""The ratetable scenario's gyro: a tactical MEMS gyro's scale-factor errors (°/s output)."""
+
+
+def scenario_ratetable(seed: int, profile: ProfileInput = None, **opts: Any) -> ScenarioResult:
+    """A gyro on a rate table (:func:`thermocal.ratetable.simulate.simulate_ladder`): the
+    default ±300 °/s ladder with small rates, run up and back down, one plateau cut short,
+    with the table's finite acceleration and overshoot; ``runs`` ladders at temperatures
+    over −20…+60 °C (one at 25 °C by default), one file each.
+
+    Parameters
+    ----------
+    seed : int
+        The seed; the same seed gives the same output.
+    profile : None
+        Must be None (no chamber program).
+    **opts
+        ``runs`` (temperatures) and ``rate_hz``.
+
+    Returns
+    -------
+    list of (Recording, dict)
+        Each recording with its truth.
+
+    Raises
+    ------
+    ThermocalInputError
+        A chamber profile or a bad option.
+    """
+    if profile is not None:
+        raise ThermocalInputError("the ratetable scenario takes no chamber profile")
+    from thermocal.ratetable.simulate import simulate_ladder
+
+    runs = int(opts.pop("runs", 1))
+    if runs < 1:
+        raise ParameterError("runs", f"{{name}} must be at least 1, got {runs}")
+    temps = [25.0] if runs == 1 else np.linspace(-20.0, 60.0, runs).tolist()
+    (rng,) = scenario_rng("ratetable", seed, 1)
+    out: ScenarioResult = []
+    for t in temps:
+        try:
+            kw: dict[str, Any] = {**opts, **RATETABLE_ERRORS}
+            rec, truth = simulate_ladder(rng, up_down=True, cut_short=30, temperature_c=t, **kw)
+        except TypeError as exc:
+            raise ThermocalInputError(f"ratetable: {exc}") from None
+        label = f"T{t:+.0f}" if runs > 1 else ""
+        out.append((rec, _plain({"scenario": "ratetable", "seed": int(seed), "label": label,
+                                 **truth})))  # fmt: skip
+    return out
+
+
 IMU_CHANNELS: tuple[tuple[str, str], ...] = (
     ("gx", "deg/s"),
     ("gy", "deg/s"),
@@ -868,6 +927,7 @@ SCENARIOS: dict[str, ScenarioFn] = {
     "turntable-thermal": scenario_turntable_thermal,
     "mems-imu": scenario_mems_imu,
     "multipos": scenario_multipos,
+    "ratetable": scenario_ratetable,
 }
 """Registry: scenario name → ``fn(seed, profile=None, **opts) -> [(Recording, truth)]``."""
 

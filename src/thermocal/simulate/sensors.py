@@ -392,7 +392,7 @@ def simulate_sensor(
     truth_rate = e + (np.asarray(input_value) + (preset.bias_constant + start + d))
     truth_rate *= dk
     del dk
-    measured = simulate_noise(n, dt, preset.noise, rng)
+    measured = simulate_noise(n, dt, preset.noise, rng, thermal.temperatures_c[:, 0])
     measured += truth_rate
     if preset.output == "pulses":
         signal = _pulse_counts(measured, dt, preset, rng)

@@ -31,6 +31,7 @@ from thermocal.firmware.ardupilot import (
     tclr_learned,
 )
 from thermocal.firmware.formats import AP_TREF_C, FORMATS
+from thermocal.heater import HeaterJudgement, HeaterOptions
 from thermocal.models.calibration import Calibration
 from thermocal.outputs import check_outputs
 from thermocal.recording import FloatArray, Recording
@@ -41,6 +42,8 @@ from thermocal.tempcal.ardupilot_baro import (
 )
 from thermocal.tempcal.compare import CoefficientComparison, compare_coefficients
 from thermocal.tempcal.flightlog import DataflashFlightLog, read_ardupilot_log
+from thermocal.tempcal.heated import judge_instance
+from thermocal.tempcal.learning import ArdupilotEmulation
 from thermocal.tempcal.pipeline import (
     AXES,
     GateWarning,
@@ -702,6 +705,9 @@ class ArdupilotTempcalResult:
     parameter_changes: tuple[dict[str, Any], ...] = ()
     """The changes during the log of the parameters undone (``time_s`` [s], ``name``,
     ``old``, ``new``); the data were undone per interval."""
+    emulated_learning: dict[str, ArdupilotEmulation] = dataclasses.field(default_factory=dict)
+    """Per IMU (``IMU.<n>``), the firmware's in-flight learning emulated on the log
+    (``emulate_learning``; :mod:`thermocal.tempcal.learning`)."""
 
     @property
     def active_found(self) -> list[str]:
@@ -733,7 +739,11 @@ class ArdupilotTempcalResult:
                 "parameter_changes": list(self.parameter_changes),
                 "imus": self.hygiene,
             },
-        }
+        } | (
+            {"emulated_learning": {k: e.to_dict() for k, e in self.emulated_learning.items()}}
+            if self.emulated_learning
+            else {}
+        )
 
 
 @dataclass
@@ -757,9 +767,14 @@ class _Run:
     baro: ArdupilotBaroFit | None = None
     allan: bool = False
     """The gyro and accelerometer reports draw each axis's Allan deviation."""
+    heater: HeaterOptions = dataclasses.field(default_factory=HeaterOptions)
+    """How each IMU's heater hold is looked for (:func:`.heated.judge_instance`)."""
     motions: dict[str, Any] = dataclasses.field(default_factory=dict)
     """Each instance's stillness from its fit (:func:`.pipeline.fit_sensor`), for the step
     warnings (computed once)."""
+    emulate: bool = False
+    """The firmware's in-flight learning is emulated on each IMU."""
+    emulated: dict[str, ArdupilotEmulation] = dataclasses.field(default_factory=dict)
     plan: ThermometerPlan = dataclasses.field(default_factory=ThermometerPlan)
     """The temperature each IMU is fitted on (:mod:`.thermometers`)."""
 
@@ -771,6 +786,8 @@ def ardupilot_tempcal(
     overrides: tuple[str, ...] = (),
     reporter: Reporter | None = None,
     allan: bool = False,
+    heater: HeaterOptions | None = None,
+    emulate_learning: bool = False,
     temperature: TemperatureMode = "reconstructed",
     temps_from: TempsFrom | None = None,
 ) -> ArdupilotTempcalResult:
@@ -792,6 +809,12 @@ def ardupilot_tempcal(
         The gyro and accelerometer reports draw each axis's overlapping Allan deviation
         before and after compensation with its noise terms (IEEE Std 952-1997 Annex C);
         default False: left out (on a long log, most of a report's cost).
+    heater : HeaterOptions, optional
+        The heater's hold (:class:`thermocal.heater.HeaterOptions`; default: the set-point
+        ``BRD_HEAT_TARG``/``BRD_IMU_TARGTEMP`` unless −1, else inferred), looked for in
+        the temperature fitted on (``temperature``, ``temps_from``).
+    emulate_learning : bool, optional
+        Also emulate the firmware's learning on each IMU (:mod:`thermocal.tempcal.learning`).
     temperature : {"reconstructed", "raw"}, optional
         A quantised or slow thermometer (:mod:`thermocal.thermometer`) is fitted on the
         temperature reconstructed at each sample (default), or on its reading as logged.
@@ -829,54 +852,51 @@ def ardupilot_tempcal(
       https://github.com/ArduPilot/ardupilot/blob/master/libraries/AP_InertialSensor/AP_InertialSensor_tempcal.cpp
     * ArduPilot, ``libraries/AP_TempCalibration/AP_TempCalibration.cpp`` (the barometer).
     """
-    from thermocal.export.params import ParamSet, check_documented, check_values
+    from thermocal.export.params import ParamSet
 
-    # DIR may hold the log; the files of the set (replaced by name) may not be it
-    names = ["calibration.json", FORMATS["ardupilot"].params_file]
-    names += [f"report_IMU_{i}_{k}.html" for i in range(MAX_IMUS) for k in ("gyro", "accel")]
-    names.append(BARO_REPORT)
-    check_outputs([output / n for n in names], [log], dirs=[output])
-    check_output_dir(output)
+    _check_set(log, output)
     with (
         report_worker(reporter, log) as pool,  # starts while the log is read
         staged_set(output, reporter, pool) as out_set,  # moved into place whole, or removed
     ):
         flight = read_ardupilot_log(log, MESSAGES)  # the log is read once, passed down
         run = _Run(log, flight, overrides, ParamSet("ardupilot"), out_set, [], [], {}, {})
-        run.allan = allan
+        run.allan, run.heater, run.emulate = allan, heater or HeaterOptions(), emulate_learning
         run.plan = ardupilot_plan(flight, temperature, temps_from)
-        _each_imu(run)
+        _imus(run)
         if not run.fits:
             raise ThermocalInputError(f"{log}: no IMU with a usable temperature in the log")
-        _baro(run)
-        run.gates.extend(step_warnings(run.fits, run.series, run.motions))
-        warn_gates(run.gates)
-        check_values(run.params)
-        check_documented(run.params)
-        out_set.commit(
-            calibration_of(run.fits), FORMATS["ardupilot"].params_file, run.params.text()
-        )
-    notes = _run_notes(run)
+        _commit(run)
     return ArdupilotTempcalResult(
         log, output / FORMATS["ardupilot"].params_file, output / "calibration.json",
-        tuple(out_set.reports),
-        tuple(run.fits), tuple(notes), run.orientation, run.hygiene, run.previous,
-        run.learning, run.baro, run.rotated, _changes_said(run),
+        tuple(out_set.reports), tuple(run.fits), tuple(_run_notes(run)), run.orientation,
+        run.hygiene, run.previous, run.learning, run.baro, run.rotated, _changes_said(run),
+        run.emulated,
     )  # fmt: skip
 
 
-def _each_imu(run: _Run) -> None:
-    """Every ``IMU`` instance of the log through :func:`_imu` (instance 0 must be there)."""
-    from thermocal.errors import MissingColumnError
+def _check_set(log: Path, output: Path) -> None:
+    """Refuse an output set that would overwrite the log (DIR may hold the log; the files of
+    the set, replaced by name, may not be it) or that is not a directory."""
+    names = ["calibration.json", FORMATS["ardupilot"].params_file, BARO_REPORT]
+    names += [f"report_IMU_{i}_{k}.html" for i in range(MAX_IMUS) for k in ("gyro", "accel")]
+    check_outputs([output / n for n in names], [log], dirs=[output])
+    check_output_dir(output)
 
-    for inst in range(MAX_IMUS):
-        try:
-            df, _info = run.flight.table("IMU", inst)
-        except MissingColumnError:
-            if inst == 0:
-                raise
-            break
-        _imu(run, df, inst)
+
+def _commit(run: _Run) -> None:
+    """The end of a run once its IMUs are fitted: the barometer, the step warnings across
+    instances, the gates said, the parameters checked and the set committed."""
+    from thermocal.export.params import check_documented, check_values
+
+    _baro(run)
+    run.gates.extend(step_warnings(run.fits, run.series, run.motions))
+    warn_gates(run.gates)
+    check_values(run.params)
+    check_documented(run.params)
+    run.out_set.commit(
+        calibration_of(run.fits), FORMATS["ardupilot"].params_file, run.params.text()
+    )
 
 
 def _run_notes(run: _Run) -> list[str]:
@@ -922,9 +942,92 @@ def _changes_said(run: _Run) -> tuple[dict[str, Any], ...]:
     return tuple(sorted(seen.values(), key=lambda c: float(c["time_s"])))
 
 
-def _imu_temperature(run: _Run, df: Any, inst: int) -> FloatArray | None:
+_IMU_FIELDS = ("T", "Temp", *(f"{p}{a}" for p in ("Gyr", "Acc") for a in "XYZ"), "AHz")
+"""The fields of ``IMU`` the calibration reads (besides ``TimeUS``; ``AHz``, the driver's
+rate, only when the log has it: the learning's emulation reads it)."""
+
+
+@dataclass
+class _ImuData:
+    """One IMU's samples as its fits take them, copied out of the log's table (which is
+    then dropped): times [s], temperatures [°C], the logged vectors per kind (n, 3); or the
+    sentence it is left out with, or the error it is refused with (each said at its turn)."""
+
+    inst: int
+    time_s: FloatArray | None = None
+    temp_c: FloatArray | None = None
+    xyz: dict[str, FloatArray] = dataclasses.field(default_factory=dict)
+    left_out: str | None = None
+    error: ThermocalInputError | None = None
+    ahz: FloatArray | None = None
+    """The driver's sample rate ``AHz`` [Hz] per row, when the log has it and the firmware's
+    learning is emulated (:func:`_emulate`)."""
+
+
+def _imu_data(run: _Run, inst: int) -> _ImuData:
+    """IMU ``inst``'s samples (:class:`_ImuData`) from a table of only the fields read;
+    raises ``MissingColumnError`` when the log has no such instance."""
+    df, _info = run.flight.table("IMU", inst, _IMU_FIELDS)
+    if not {"T", "Temp"} & set(df.columns) or not set(_IMU_FIELDS[2:8]) <= set(df.columns):
+        df, _info = run.flight.table("IMU", inst)  # every field: the refusal names them
+    try:
+        temp_c = _imu_temperature(run, df, inst)
+    except ThermocalInputError as exc:
+        return _ImuData(inst, error=exc)
+    if isinstance(temp_c, str):
+        return _ImuData(inst, left_out=temp_c)
+    xyz = {
+        kind: _compact(np.column_stack([df[f"{prefix}{a.upper()}"].to_numpy() for a in AXES]))
+        for kind, prefix, _unit in KINDS
+    }
+    ahz = df["AHz"].to_numpy() if run.emulate and "AHz" in df.columns else None
+    return _ImuData(inst, df["TimeUS"].to_numpy() * 1e-6, _compact(temp_c), xyz, ahz=ahz)
+
+
+def _compact(x: FloatArray) -> Any:
+    """``x`` held as float32 while it waits for its turn when that keeps every value (the
+    log's float32 fields, made float64 by the reader): half the memory, the same numbers
+    once made float64 again; else ``x`` as it is."""
+    x32 = x.astype(np.float32)
+    return x32 if np.array_equal(x32, x, equal_nan=True) else x
+
+
+def _imus(run: _Run) -> None:
+    """Every IMU of the log through :func:`_imu`, in turn.  Each one's samples are copied
+    out of the log first (:func:`_imu_data`) and the log's rows released, so that the fits
+    and the reports hold the samples once; each IMU's are given back after its turn."""
+    from thermocal.errors import MissingColumnError
+
+    datas: list[_ImuData] = []
+    for inst in range(MAX_IMUS):
+        try:
+            data = _imu_data(run, inst)
+        except MissingColumnError:
+            if inst == 0:
+                raise
+            break
+        except ThermocalInputError as exc:  # refused at its turn, after the IMUs before it
+            data = _ImuData(inst, error=exc)
+        datas.append(data)
+        if data.error is not None:
+            break  # the run stops there: no later IMU is read
+    for name in ("IMU", "IMU2", "IMU3"):  # the rows of the log, all copied out
+        run.flight.release(name)
+    while datas:
+        data = datas.pop(0)
+        if data.error is not None:
+            raise data.error
+        if data.left_out is not None:
+            warnings.warn(GateWarning(data.left_out), stacklevel=2)
+            continue
+        _imu(run, data)
+        del data
+
+
+def _imu_temperature(run: _Run, df: Any, inst: int) -> FloatArray | str:
     """The temperature of IMU ``inst`` [°C] (field ``T``, ``Temp`` in Copter 3.4–3.6;
-    refused when neither is there); None, with a warning, when it is all 0 or NaN."""
+    refused when neither is there); the sentence it is left out with when it is all 0 or
+    NaN."""
     tcol = next((c for c in ("T", "Temp") if c in df.columns), None)
     if tcol is None:  # LogStructure.h: ``T`` (``Temp`` in Copter 3.4–3.6)
         raise ThermocalInputError(
@@ -932,30 +1035,29 @@ def _imu_temperature(run: _Run, df: Any, inst: int) -> FloatArray | None:
             + ", ".join(map(str, df.columns))
         )
     require_fields(df, [f"{p}{a}" for p in ("Gyr", "Acc") for a in "XYZ"], run.log, f"IMU.{inst}")
-    temp_c: FloatArray = df[tcol].to_numpy()
+    # a copy: a view would keep the table's whole float64 block (every field) alive
+    temp_c: FloatArray = df[tcol].to_numpy(dtype=np.float64, copy=True)
     if not np.isfinite(temp_c).any() or np.all(temp_c[np.isfinite(temp_c)] == 0):
-        warnings.warn(
-            GateWarning(
-                f"{run.log}: IMU.{inst} left out: its temperature is all 0 or NaN (a sensor "
-                "without a thermometer cannot be calibrated over temperature)"
-            ),
-            stacklevel=3,
+        return (
+            f"{run.log}: IMU.{inst} left out: its temperature is all 0 or NaN (a sensor "
+            "without a thermometer cannot be calibrated over temperature)"
         )
-        return None
     return temp_c
 
 
-def _imu(run: _Run, df: Any, inst: int) -> None:
+def _imu(run: _Run, data: _ImuData) -> None:
     """One IMU: its gyro and accelerometer back to the sensor frame (:func:`ardupilot_raw`)
     and through the pipeline, its ``INS_TCAL<n>`` parameters, hygiene, gates and reports."""
     from thermocal.export.params import export_params
 
-    temp_c = _imu_temperature(run, df, inst)
-    if temp_c is None:
-        return
-    time_s = df["TimeUS"].to_numpy() * 1e-6
-    run.gates.append(stall_warning(f"IMU.{inst}", time_s, temp_c))
+    assert data.time_s is not None and data.temp_c is not None
+    inst, time_s = data.inst, data.time_s
+    # the IMU's thermometer as logged (exact: see _compact): what the firmware read, for
+    # undoing its corrections and emulating its learning; the fits take the plan's
+    temp_c: FloatArray = data.temp_c.astype(np.float64)
+    held: HeaterJudgement | None = None  # judged once, on the temperature fitted on
     per_kind: list[tuple[SensorFit, Recording]] = []
+    raw: dict[str, FloatArray] = {}  # what the firmware's learner is fed, per kind
     intervals, changes = param_intervals(
         run.flight.parameters,
         run.flight.parameter_changes,
@@ -963,8 +1065,10 @@ def _imu(run: _Run, df: Any, inst: int) -> None:
     )
     prev_params = _previous_params(run, inst, intervals, changes, time_s)
     for kind, prefix, unit in KINDS:
-        xyz = np.column_stack([df[f"{prefix}{a.upper()}"].to_numpy() for a in AXES])
+        xyz = data.xyz.pop(kind).astype(np.float64)  # exact (_compact); given back once undone
         xyz, actives, codes = ardupilot_raw_intervals(intervals, inst, kind, time_s, temp_c, xyz)
+        if run.emulate:
+            raw[kind] = xyz
         run.orientation = codes[-1]
         run.rotated = run.rotated or any(codes)
         active = ardupilot_active(prev_params, inst)
@@ -985,10 +1089,13 @@ def _imu(run: _Run, df: Any, inst: int) -> None:
             sub_rec, f"IMU.{inst}", temperature=run.plan.temperature,
             source=run.plan.source_for(kind, inst),
         )  # fmt: skip
+        if held is None:  # one thermometer per IMU: the same for its two sensors
+            held = _heater(run, inst, sub_rec)
         fit = fit_sensor(
             sub_rec, f"IMU.{prefix}", kind, inst, overrides=run.overrides,
             firmware="ardupilot", motions=run.motions,
         )  # fmt: skip
+        fit.heater = held.to_dict()
         said = record_thermometer(fit, thermo, f"IMU.{inst}")
         if said and kind == "gyro":  # one thermometer per IMU: said once
             run.params.notes.append(said)
@@ -1000,16 +1107,44 @@ def _imu(run: _Run, df: Any, inst: int) -> None:
             del vals
         # the step check across instances reads the stillness result (motions), not values
         run.series[f"{fit.topic}.{inst}"] = (time_s, np.empty((0, len(AXES))))
+    assert held is not None  # KINDS is not empty
     sub = Calibration([ch for f, _r in per_kind for ch in f.channels])
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         ps = export_params(sub, "ardupilot", instance=inst)
     run.params.merge(ps, f"IMU.{inst}")
+    run.params.notes.extend(f"IMU.{inst}: {n}" for n in held.notes if held.hold is not None)
     _hygiene_and_gates(run, inst, ps, prev_params)
     active = ardupilot_active(prev_params, inst)
     fw_range = tclr_range(
         run.flight.rows("TCLR"), inst, run.flight.parameter_changes, time_s, temp_c
     )
+    emulated = (
+        _emulate(run, inst, data.ahz, time_s, temp_c, raw, ps.params) if run.emulate else None
+    )
+    _reports(run, inst, per_kind, ps, held, emulated, active, fw_range)
+
+
+def _heater(run: _Run, inst: int, rec: Recording) -> HeaterJudgement:
+    """IMU ``inst``'s heater hold (:func:`.heated.judge_instance`) judged on the temperature
+    its fits take (``rec``'s: reconstructed, or borrowed), its warnings and a stall's
+    (no hold, or an inferred one) added to the run's gates."""
+    time_s, temp_c = rec.time_s, rec.temperature_c("temperature")
+    held = judge_instance(
+        f"{run.log}: IMU.{inst}", time_s, temp_c, run.flight.parameters, "ardupilot", run.heater
+    )
+    run.gates.extend(held.warnings)
+    if held.hold is None or held.hold.setpoint_source == "inferred":  # a stall, or a heater?
+        run.gates.append(stall_warning(f"IMU.{inst}", time_s, temp_c))
+    return held
+
+
+def _reports(
+    run: _Run, inst: int, per_kind: list[tuple[SensorFit, Recording]], ps: Any,
+    held: HeaterJudgement, emulated: ArdupilotEmulation | None, active: Any, fw_range: Any,
+) -> None:  # fmt: skip
+    """IMU ``inst``'s gyro and accelerometer compared with the log's coefficients and the
+    firmware's learning (``active``, ``fw_range``), and their reports requested."""
     for fit, sub_rec in per_kind:
         key = f"{fit.topic}.{inst}"
         if active is not None:  # the log's coefficients against the new ones
@@ -1029,11 +1164,38 @@ def _imu(run: _Run, df: Any, inst: int) -> None:
                 calibration=Calibration(fit.channels), recording=sub_rec,
                 recording_path=str(run.log), title=f"ArduPilot thermal calibration — IMU {inst} "
                 f"{fit.kind}", generated_by="thermocal ardupilot-tempcal",
-                notes=(*(f"Firmware: {n}" for n in ps.notes), *(() if run.allan else (NO_ALLAN,))),
+                notes=(
+                    *(f"Firmware: {n}" for n in ps.notes), *(f"Heater: {n}" for n in held.notes),
+                    *(() if run.allan else (NO_ALLAN,)),
+                ),
                 previous=run.previous.get(key),
                 firmware_learning=run.learning.get(key), allan=run.allan,
+                emulated_learning=emulated.against_thermocal.get(fit.kind) if emulated else None,
             ),
         )  # fmt: skip
+
+
+def _emulate(
+    run: _Run, inst: int, ahz: FloatArray | None, time_s: FloatArray, temp_c: FloatArray,
+    raw: dict[str, FloatArray], new_params: Mapping[str, float],
+) -> ArdupilotEmulation:  # fmt: skip
+    """The firmware's learning of IMU ``inst`` emulated (:func:`.learning.emulate_ardupilot`),
+    fed at the driver's rate ``AHz`` of the ``IMU`` message when the log has it."""
+    from thermocal.tempcal.learning import emulate_ardupilot, samples_per_logged
+
+    ok = np.isfinite(time_s) & np.isfinite(temp_c)  # samples the firmware could not use
+    for v in raw.values():
+        ok &= np.isfinite(v).all(axis=1)
+    em = emulate_ardupilot(
+        inst, time_s[ok], temp_c[ok], {k: v[ok] for k, v in raw.items()},
+        parameters=run.flight.parameters, new_params=new_params,
+        tclr_rows=run.flight.rows("TCLR"),
+        samples_per_sample=samples_per_logged(
+            time_s[ok], None if ahz is None else ahz[ok]
+        ),
+    )  # fmt: skip
+    run.emulated[f"IMU.{inst}"] = em
+    return em
 
 
 def _baro(run: _Run) -> None:

@@ -23,7 +23,7 @@ References
 from __future__ import annotations
 
 import contextlib
-from collections.abc import Iterator, Mapping
+from collections.abc import Iterator, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -194,7 +194,21 @@ class DataflashFlightLog:
         """
         return self.passed.message_rows(message)
 
-    def table(self, message: str, instance: int) -> tuple[pd.DataFrame, dict[str, Any]]:
+    def release(self, message: str) -> None:
+        """Forget the columns of ``message`` kept by the pass (their memory given back);
+        a later :meth:`table` of it finds none.
+
+        Parameters
+        ----------
+        message : str
+            A message type among :attr:`messages` (``IMU``).
+        """
+        self.passed.columns.pop(message, None)
+        self.passed.rows.pop(message, None)
+
+    def table(
+        self, message: str, instance: int, fields: Sequence[str] | None = None
+    ) -> tuple[pd.DataFrame, dict[str, Any]]:
         """Instance ``instance`` of ``message`` as a table in the firmware's units, served
         from the log's one pass (:func:`thermocal.readers.dataflash.dataflash_table`).
 
@@ -204,6 +218,8 @@ class DataflashFlightLog:
             The message type (``IMU``, ``BARO``).
         instance : int
             The instance, 0-based (``IMU2`` of older logs is ``IMU`` instance 1).
+        fields : sequence of str, optional
+            Only these fields (those the message has, ``TimeUS`` always); None: all.
 
         Returns
         -------
@@ -217,7 +233,7 @@ class DataflashFlightLog:
         """
         from thermocal.readers.dataflash import dataflash_table
 
-        return dataflash_table(self.passed, self.path, message, instance)
+        return dataflash_table(self.passed, self.path, message, instance, fields)
 
 
 def read_ardupilot_log(path: Path, messages: tuple[str, ...]) -> DataflashFlightLog:

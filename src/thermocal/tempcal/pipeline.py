@@ -75,6 +75,8 @@ class SensorFit:
     thermometer : dict
         The temperature fitted on: its thermometer (lattice step, update period), whether
         reconstructed, and whose (:func:`.thermometers.sensor_temperature`).
+    heater : dict or None
+        The heater's hold (:class:`thermocal.heater.HeaterHold`), None: none found.
     """
 
     topic: str
@@ -89,6 +91,9 @@ class SensorFit:
     channels: list[Channel] = field(default_factory=list)
     adequacy: dict[str, Any] = field(default_factory=dict)
     thermometer: dict[str, Any] = field(default_factory=dict)
+    heater: dict[str, Any] | None = None
+    """The heater's hold found in its temperature (:meth:`thermocal.heater.HeaterHold.to_dict`),
+    None: none."""
 
 
 def _cubic(t: FloatArray, y: FloatArray, unit: str, name: str) -> PolyModel:
@@ -464,6 +469,9 @@ class ReportRequest:
         The coefficients active in the log against the new ones.
     firmware_learning : CoefficientComparison or None
         The firmware's own learned coefficients against the new ones.
+    emulated_learning : CoefficientComparison or None
+        What the firmware's own learning, emulated on the log, would store against the new
+        ones.
     allan : bool
         Draw each channel's Allan deviation before and after compensation with its noise
         terms (default False: left out; most of a report's cost on a long log).
@@ -483,6 +491,9 @@ class ReportRequest:
     """The firmware's own learned coefficients (ArduPilot ``TCLR``) against the new ones."""
     allan: bool = False
     """Each channel's Allan deviation section drawn (False: left out, not computed)."""
+    emulated_learning: CoefficientComparison | None = None
+    """What the firmware's own learning, emulated on the log, would store against the new
+    coefficients (:mod:`thermocal.tempcal.learning`)."""
 
 
 AnyReportRequest = ReportRequest | OffsetReportRequest | ArdupilotBaroReportRequest

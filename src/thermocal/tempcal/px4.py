@@ -38,11 +38,13 @@ from thermocal import adequacy
 from thermocal.errors import ParameterError, ThermocalInputError
 from thermocal.firmware.formats import FORMATS
 from thermocal.firmware.px4 import px4_coefficients
+from thermocal.heater import HeaterOptions
 from thermocal.models.calibration import Calibration
 from thermocal.outputs import check_outputs
-from thermocal.recording import FloatArray
+from thermocal.recording import FloatArray, Recording
 from thermocal.tempcal.compare import CoefficientComparison, px4_comparison
 from thermocal.tempcal.flightlog import FlightLog, open_px4_log
+from thermocal.tempcal.learning import Px4Emulation, px4_overall
 from thermocal.tempcal.pipeline import (
     AXES,
     OutputSet,
@@ -269,6 +271,9 @@ class Px4TempcalResult:
     notes: tuple[str, ...]
     previous: dict[str, CoefficientComparison] = dataclasses.field(default_factory=dict)
     """Per sensor, the log's ``TC_*`` for its device against the new ones."""
+    emulated_learning: dict[str, Px4Emulation] = dataclasses.field(default_factory=dict)
+    """Per gyro and accelerometer instance, PX4's on-board temperature calibration emulated
+    on the log (``emulate_learning``; :mod:`thermocal.tempcal.learning`)."""
 
     def to_dict(self) -> dict[str, Any]:
         """The result as a JSON object (what the ``px4-tempcal`` command prints as JSON)."""
@@ -282,7 +287,11 @@ class Px4TempcalResult:
                 for k, v in {**summary(self.fits), **offset_summary(self.offset_fits)}.items()
             },
             "notes": list(self.notes),
-        }
+        } | (
+            {"emulated_learning": px4_overall(self.emulated_learning)}
+            if self.emulated_learning
+            else {}
+        )
 
 
 NO_SENSOR = "no sensor_gyro or sensor_accel topic with a temperature in the log"
@@ -301,6 +310,8 @@ def px4_tempcal(
     overrides: tuple[str, ...] = (),
     reporter: Reporter | None = None,
     allan: bool = False,
+    heater: HeaterOptions | None = None,
+    emulate_learning: bool = False,
     temperature: TemperatureMode = "reconstructed",
     temps_from: TempsFrom | None = None,
 ) -> Px4TempcalResult:
@@ -324,6 +335,16 @@ def px4_tempcal(
         The gyro and accelerometer reports draw each axis's overlapping Allan deviation
         before and after compensation with its noise terms (IEEE Std 952-1997 Annex C);
         default False: left out (on a long log, most of a report's cost).
+    heater : HeaterOptions, optional
+        How a heater's hold is looked for (default: the set-point ``SENS_IMU_TEMP`` when
+        ``SENS_EN_THERMAL`` is on, else inferred; ±0.5 °C for 60 s; a cut range said,
+        :class:`thermocal.heater.HeaterOptions`), in the temperature fitted on
+        (``temperature``, ``temps_from``).
+    emulate_learning : bool, optional
+        Also emulate PX4's on-board temperature calibration (``SYS_CAL_TDEL``,
+        ``SYS_CAL_TMIN``, ``SYS_CAL_TMAX`` from the log, else PX4's defaults) on each gyro
+        and accelerometer instance (:func:`thermocal.tempcal.learning.emulate_px4`);
+        default False.
     temperature : {"reconstructed", "raw"}, optional
         A quantised or slow thermometer (:mod:`thermocal.thermometer`) is fitted on the
         temperature reconstructed at each sample (default), or on its reading as logged.
@@ -374,8 +395,11 @@ def px4_tempcal(
         report_worker(reporter, log) as pool,  # starts while the log is read
         open_px4_log(log, (*TOPICS, *OFFSET_TOPICS)) as flight,  # the log is parsed once
     ):
-        plan = px4_plan(flight, temperature, temps_from)
-        return _px4_tempcal(flight, output, tref_c, overrides, reporter, pool, allan, plan)
+        return _px4_tempcal(
+            flight, output, tref_c, overrides, reporter, pool, allan,
+            heater or HeaterOptions(), {} if emulate_learning else None,
+            px4_plan(flight, temperature, temps_from),
+        )  # fmt: skip
 
 
 def _px4_tempcal(
@@ -386,10 +410,13 @@ def _px4_tempcal(
     reporter: Reporter | None,
     pool: Any = None,
     allan: bool = False,
+    heater: HeaterOptions | None = None,
+    emulated: dict[str, Px4Emulation] | None = None,
     plan: ThermometerPlan | None = None,
 ) -> Px4TempcalResult:
-    """:func:`px4_tempcal` after its output checks (``pool``: the report worker; ``plan``:
-    the temperature each instance is fitted on)."""
+    """:func:`px4_tempcal` after its output checks (``pool``: the report worker;
+    ``emulated``: filled with the on-board calibration emulated, when given; ``plan``: the
+    temperature each instance is fitted on)."""
     from thermocal.export.params import ParamSet
 
     log, topics = flight.path, flight.instances
@@ -414,7 +441,7 @@ def _px4_tempcal(
                 continue
             fit, more = _imu_instance(
                 flight, name, inst, tref_c, overrides, params, out_set, (series, motions), old,
-                allan, plan or ThermometerPlan(),
+                allan, heater or HeaterOptions(), emulated, plan or ThermometerPlan(),
             )  # fmt: skip
             fits.append(fit)
             gates.extend(more)
@@ -431,7 +458,7 @@ def _px4_tempcal(
     return Px4TempcalResult(
         log, output / FORMATS["px4"].params_file, output / "calibration.json",
         tuple(out_set.reports),
-        tuple(fits), tuple(offset_fits), tuple(params.notes), old.found,
+        tuple(fits), tuple(offset_fits), tuple(params.notes), old.found, emulated or {},
     )  # fmt: skip
 
 
@@ -542,15 +569,19 @@ def _imu_instance(
     found: tuple[dict[str, tuple[FloatArray, FloatArray]], dict[str, adequacy.Motion]],
     old: _Prior,
     allan: bool = False,
+    heater: HeaterOptions | None = None,
+    emulated: dict[str, Px4Emulation] | None = None,
     plan: ThermometerPlan | None = None,
 ) -> tuple[SensorFit, list[str | None]]:
     """A gyro or accelerometer instance through the pipeline: read, fit, its gates, its
     ``TC_G``/``TC_A`` parameters merged into ``params``, its report (``allan``: with its
     Allan section); ``found`` (series, motions) gets its (time [s], x/y/z in the canonical
-    unit) and its stillness result for the step check across instances; ``plan``: the
-    temperature it is fitted on."""
+    unit) and its stillness result for the step check across instances; ``heater``: how its
+    heater's hold is looked for (:func:`.heated.judge_instance`) in the temperature fitted
+    on; ``plan``: that temperature (reconstructed, or borrowed)."""
     from thermocal.export.params import export_params
     from thermocal.readers.ulog import release_parsed_topic
+    from thermocal.tempcal.heated import judge_instance
 
     kind = "gyro" if name == "sensor_gyro" else "accel"
     where = f"{name}.{inst}"
@@ -558,16 +589,20 @@ def _imu_instance(
     rec = flight.recording(where)
     release_parsed_topic(log, where)  # read once: its raw messages are not needed again
     series, motions = found
-    plan = plan or ThermometerPlan()
-    rec, thermo = sensor_temperature(
-        rec, where, temperature=plan.temperature, source=plan.source_for(kind, inst)
+    logged = rec if emulated is not None else None  # the firmware learns on its own, as logged
+    rec, thermo = _planned_temperature(rec, where, kind, inst, plan or ThermometerPlan())
+    temp_c = rec.temperature_c("temperature")
+    held = judge_instance(
+        f"{log}: {where}", rec.time_s, temp_c, flight.parameters, "px4", heater or HeaterOptions()
     )
     fit = fit_sensor(rec, name, kind, inst, overrides=overrides, motions=motions)
+    fit.heater = held.to_dict()
     said = record_thermometer(fit, thermo, where)
-    temp_c = rec.temperature_c("temperature")
     # the step check across instances reads the stillness result (motions), not the values
     series[where] = (rec.time_s, np.empty((0, len(AXES))))
-    gates = [stall_warning(where, rec.time_s, temp_c)]
+    gates: list[str | None] = [*held.warnings]
+    if held.hold is None or held.hold.setpoint_source == "inferred":  # a stall, or a heater?
+        gates.append(stall_warning(where, rec.time_s, temp_c))
     if kind == "gyro":
         vals = np.column_stack([rec.signal(a)[0] for a in AXES])
         gates.append(gyro_unit_warning(f"{log}: {where}", vals))
@@ -581,12 +616,15 @@ def _imu_instance(
             sub, "px4", instance=inst, device_id={kind: fit.device_id}, tref_c=tref_c
         )
     params.merge(ps, where)
-    if said:
-        params.notes.append(said)
+    params.notes.extend([said] if said else [])
+    params.notes.extend(f"{where}: {n}" for n in held.notes if held.hold is not None)
     prev = old.compare(
         where, ps.params, kind, inst, fit.device_id, "rad/s" if kind == "gyro" else "m/s^2",
         fit.sweep_c,
     )  # fmt: skip
+    em = None if logged is None else _emulate(flight, logged, where, kind, inst, fit, ps.params)
+    if em is not None and emulated is not None:
+        emulated[where] = em
     shown = (*AXES, "temperature")  # what the report reads: the device id column left here
     rec = dataclasses.replace(
         rec, columns={k: v for k, v in rec.columns.items() if k in shown},
@@ -608,13 +646,43 @@ def _imu_instance(
                 "ones, in the canonical unit (°/h or mg).",
                 *(f"Firmware: {n}" for n in ps.notes),
                 *((f"Temperature: {said}",) if said else ()),
+                *(f"Heater: {n}" for n in held.notes),
                 *(() if allan else (NO_ALLAN,)),
             ),
             previous=prev,
             allan=allan,
+            emulated_learning=None if em is None else em.against_thermocal,
         ),
     )  # fmt: skip
     return fit, gates
+
+
+def _planned_temperature(
+    rec: Recording, where: str, kind: str, inst: int, plan: ThermometerPlan
+) -> tuple[Recording, dict[str, Any]]:
+    """Instance ``where``'s recording with the temperature it is fitted on (``plan``: its
+    own reconstructed when coarse or slow, or another's joined by time) and what was done
+    (:func:`.thermometers.sensor_temperature`)."""
+    return sensor_temperature(
+        rec, where, temperature=plan.temperature, source=plan.source_for(kind, inst)
+    )
+
+
+def _emulate(
+    flight: FlightLog, rec: Recording, where: str, kind: str, inst: int, fit: SensorFit,
+    new_params: Any,
+) -> Px4Emulation:  # fmt: skip
+    """PX4's on-board calibration of one instance emulated on its samples in PX4's units
+    (rad/s, m/s²; the time since boot)."""
+    from thermocal.tempcal.learning import emulate_px4
+    from thermocal.units import convert
+
+    unit = "rad/s" if kind == "gyro" else "m/s^2"
+    vals = np.column_stack([convert(*rec.signal(a), unit, where) for a in AXES])
+    return emulate_px4(
+        kind, inst, rec.time_s, vals, rec.temperature_c("temperature"),
+        parameters=flight.parameters, new_params=new_params, device_id=fit.device_id,
+    )  # fmt: skip
 
 
 __all__ = [

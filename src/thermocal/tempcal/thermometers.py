@@ -357,8 +357,8 @@ def ardupilot_plan(
     if temps_from is None:
         return ThermometerPlan(temperature)
     msg, inst = ("BARO", 0) if temps_from.source == "baro" else ("IMU", int(temps_from.source))
-    try:
-        df, _info = flight.table(msg, inst)
+    try:  # only the fields read: the log's other fields are not copied
+        df, _info = flight.table(msg, inst, ("T", "Temp"))
     except MissingColumnError:
         df = None
     col = next((c for c in ("T", "Temp") if df is not None and c in df.columns), None)
@@ -376,7 +376,7 @@ def _ardupilot_have(flight: Any) -> list[str]:
     for msg, n in (("IMU", 3), ("BARO", 1)):
         for i in range(n):
             try:
-                flight.table(msg, i)
+                flight.table(msg, i, ("T", "Temp"))
             except MissingColumnError:
                 break
             found.append(f"{msg}.{i}")

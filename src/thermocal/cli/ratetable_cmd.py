@@ -1,0 +1,193 @@
+"""``thermocal ratetable FILE... [--rate-column COL | --rates R1,R2,… | --schedule FILE]``:
+a gyro's scale factor, nonlinearity, asymmetry, bias per rate, input threshold, resolution
+and repeatability from a rate-table ladder; with ``--temps`` at several temperatures, the
+scale factor's temperature coefficient.
+
+The library does the work (:func:`thermocal.pipeline.ratetable.ratetable_files`); this
+module parses the options and prints the result."""
+
+from pathlib import Path
+from typing import TYPE_CHECKING, Annotated
+
+import typer
+
+from thermocal._lazy import LazyModule
+from thermocal.cli.application import app
+from thermocal.cli.common import (
+    DecimalOpt,
+    DelimiterOpt,
+    JsonOpt,
+    NamesOpt,
+    OnBadLinesOpt,
+    RateOpt,
+    TimeOpt,
+    TimeUnitOpt,
+    emit,
+    handle_errors,
+    read_options,
+    show,
+    split_floats,
+)
+from thermocal.errors import ThermocalInputError
+
+if TYPE_CHECKING:
+    import thermocal.pipeline.ratetable as _files
+    import thermocal.report.ratetable as _report
+    import thermocal.report.ratetable_text as _text
+    import thermocal.writers as _writers
+else:
+    _files = LazyModule("thermocal.pipeline.ratetable")
+    _report = LazyModule("thermocal.report.ratetable")
+    _text = LazyModule("thermocal.report.ratetable_text")
+    _writers = LazyModule("thermocal.writers")
+
+FilesArg = Annotated[
+    list[Path],
+    typer.Argument(
+        help="Rate-table recording(s) (CSV, Parquet, text log); several: one per temperature "
+        "(with --temps).",
+        show_default=False,
+    ),
+]
+GyroOpt = Annotated[str, typer.Option("--gyro", help="The gyro's output column.")]
+GyroUnitOpt = Annotated[
+    str | None,
+    typer.Option(
+        "--gyro-unit",
+        help="Its unit: deg/s, deg/h, rad/s (scale factor dimensionless), counts or V (scale "
+        "factor per °/s); default: the file's.",
+    ),
+]
+RateColumnOpt = Annotated[
+    str | None,
+    typer.Option(
+        "--rate-column", help="The table's rate column [°/s]: plateaus where it holds still."
+    ),
+]
+RatesOpt = Annotated[
+    str | None,
+    typer.Option(
+        "--rates",
+        help="The applied rates [°/s], one per plateau in the order run, e.g. "
+        "-300,-100,0,100,300 (plateaus found in the output).",
+    ),
+]
+ScheduleOpt = Annotated[
+    Path | None,
+    typer.Option("--schedule", help="CSV of the plateaus: start_s,end_s,rate_dps rows."),
+]
+TempsOpt = Annotated[
+    str | None,
+    typer.Option(
+        "--temps",
+        help="Temperature column [°C]: ladders at several temperatures give the scale "
+        "factor's temperature coefficient.",
+    ),
+]
+SettleOpt = Annotated[
+    float, typer.Option("--settle", help="Settling left out at each plateau's start [s].")
+]
+MinPlateauOpt = Annotated[float, typer.Option("--min-plateau", help="Shortest plateau [s].")]
+WindowOpt = Annotated[
+    float, typer.Option("--window", help="Window of the output's plateau detector [s].")
+]
+SmallOpt = Annotated[
+    float,
+    typer.Option(
+        "--small-fraction",
+        help="Rates up to this fraction of full scale are the input-threshold test's.",
+    ),
+]
+TempGapOpt = Annotated[
+    float,
+    typer.Option(
+        "--temp-gap", help="One file: plateaus further apart than this [°C] are two ladders."
+    ),
+]
+OneDirectionOpt = Annotated[
+    bool,
+    typer.Option("--one-direction", help="Accept a ladder in one direction only (no asymmetry)."),
+]
+RateToleranceOpt = Annotated[
+    float,
+    typer.Option(
+        "--rate-tolerance",
+        help="Largest change of --rate-column between two samples of a plateau [°/s] (a "
+        "noisy encoder rate needs more).",
+    ),
+]
+ReportOpt = Annotated[
+    Path | None,
+    typer.Option("--report", help="Also write the spec sheet as a self-contained HTML page."),
+]
+ResultOpt = Annotated[
+    Path | None, typer.Option("-o", "--output", help="Also write the result as JSON here.")
+]
+
+
+@app.command("ratetable")
+@handle_errors
+def ratetable_cmd(
+    files: FilesArg,
+    gyro: GyroOpt = "gyro",
+    signal_unit: GyroUnitOpt = None,
+    rate_column: RateColumnOpt = None,
+    rates_dps: RatesOpt = None,
+    schedule: ScheduleOpt = None,
+    temps: TempsOpt = None,
+    settle_s: SettleOpt = 1.0,
+    min_plateau_s: MinPlateauOpt = 5.0,
+    window_s: WindowOpt = 0.5,
+    small_fraction: SmallOpt = 0.01,
+    temp_gap_c: TempGapOpt = 3.0,
+    one_direction: OneDirectionOpt = False,
+    tolerance_dps: RateToleranceOpt = 1e-3,
+    output: ResultOpt = None,
+    report: ReportOpt = None,
+    time: TimeOpt = None,
+    time_unit: TimeUnitOpt = None,
+    t_names: NamesOpt = None,
+    t_rate: RateOpt = None,
+    t_bad: OnBadLinesOpt = "error",
+    t_delim: DelimiterOpt = None,
+    t_dec: DecimalOpt = None,
+    as_json: JsonOpt = False,
+) -> None:
+    """Gyro scale factor, nonlinearity, asymmetry, bias per rate, input threshold and
+    resolution from a rate-table ladder (IEEE Std 952/1431); with --temps at several
+    temperatures, the scale factor's temperature coefficient."""
+    inputs: list[str | Path] = [*files, *([schedule] if schedule else [])]
+    for out in (output, report):
+        if out is not None:
+            _writers.check_not_input(out, inputs)
+    if output is not None and output == report:
+        raise ThermocalInputError("-o and --report name the same file; give two files")
+    rates = split_floats(rates_dps, "--rates")
+    opts = _files.RateTableOptions(
+        gyro,
+        signal_unit,
+        rate_column,
+        tuple(rates) if rates is not None else None,
+        temps,
+        settle_s,
+        min_plateau_s,
+        window_s,
+        small_fraction,
+        temp_gap_c,
+        time,
+        time_unit,
+        read_options(
+            names=t_names, rate=t_rate, on_bad_lines=t_bad, delimiter=t_delim, decimal=t_dec
+        ),
+        one_direction,
+        tolerance_dps,
+    )
+    res = _files.ratetable_files(files, opts, schedule=schedule)
+    if output is not None:
+        _writers.write_json(output, res.to_dict())
+    if report is not None:
+        _writers.write_html(report, _report.ratetable_html(res))
+    emit(res.to_dict(), as_json, lambda: show(_text.ratetable_text(res)))
+
+
+__all__ = ["ratetable_cmd"]

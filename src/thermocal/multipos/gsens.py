@@ -1,0 +1,266 @@
+r"""Gyro sensitivity to specific force (g-sensitivity) from the static poses.
+
+A gyro's bias moves with the specific force it feels: IEEE Std 952-1997 (fibre-optic
+gyros, annex B, the model's *acceleration-sensitive drift* terms) and IEEE Std 1431-2004
+(Coriolis vibratory gyros) write the rate output's bias as ``D_F + Σ_j D_j a_j`` with
+``a_j`` the specific force along axis j in g.  For the triad the nine coefficients make the
+matrix ``A`` of
+
+.. math::
+
+    \bar\omega_k = b + A\, f_k + \Omega \sin L\, u_k + e_k,                 (1)
+
+with :math:`\bar\omega_k` the mean rate of static pose k, :math:`f_k = (g_k/g_0)\, u_k`
+its specific force in g along the calibrated up direction :math:`u_k` (the accelerometer's
+calibration gives it), :math:`\Omega \sin L\, u_k` the vertical earth rate at latitude L
+and :math:`e_k` the pose's noise: white noise :math:`\sigma_i^2/n_k` and the horizontal
+earth rate, whose direction in the board (the pose's heading) is not measured and counts
+as noise of variance :math:`(\Omega\cos L)^2 (1 - u_{ki}^2)/2` per axis (without L:
+:math:`\Omega^2/3`), as the static bias does (:func:`thermocal.multipos.gyro.static_bias`).
+
+Each gyro axis i is one weighted least-squares problem in :math:`(b_i, A_{i1}, A_{i2},
+A_{i3})` over the poses, solved by QR of the whitened design (Golub & Van Loan §5.3): it
+needs at least four poses whose gravity directions are not all in one plane through the
+board (a design of rank 4); the six faces give it, each coefficient then the half
+difference of a face pair.  Its covariance is :math:`(X^\top W X)^{-1}`, scaled by the
+reduced χ² when the scatter is beyond the noise model (a bias that also drifts with
+time or temperature between the poses).
+
+The matrix is an estimate of the gyro's sensitivity, reported with its σ: the rotations'
+fit (:mod:`thermocal.multipos.gyro`) does not model it, so on a gyro with a large one the
+motions carry it as a misfit (their reduced χ²).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+import numpy.typing as npt
+
+from thermocal import units
+from thermocal.errors import DesignError
+from thermocal.recording import FloatArray
+
+MIN_POSES = 4
+"""Poses the fit of eq. (1) needs per axis (a bias and three sensitivities)."""
+
+MAX_DESIGN_COND = 1e4
+"""Largest condition number of the column-scaled design ``[1, f_x, f_y, f_z]`` accepted:
+beyond it the poses' gravity directions lie (nearly) in one plane through the board and one
+column of ``A`` is not seen."""
+
+SIGNIFICANT_SIGMA = 3.0
+"""An element of ``A`` farther than this many σ from 0 is a g-sensitivity found."""
+
+
+@dataclass(frozen=True)
+class GSensitivity:
+    """The gyro's sensitivity to specific force, eq. (1) of the module docstring.
+
+    Attributes
+    ----------
+    matrix_deg_h_g : numpy.ndarray, shape (3, 3)
+        ``A``: row i the gyro axis, column j the specific force's axis [°/h per g].
+    sigma_deg_h_g : numpy.ndarray, shape (3, 3)
+        Its standard uncertainties [°/h per g].
+    bias_deg_h : numpy.ndarray, shape (3,)
+        ``b`` of eq. (1), the bias at zero specific force [°/h].
+    reduced_chi2 : numpy.ndarray, shape (3,)
+        Each axis's reduced χ² (NaN with no degree of freedom).
+    dof : int
+        Degrees of freedom per axis: poses less four.
+    n_poses : int
+        Static poses used.
+    design_cond : float
+        Condition number of the column-scaled design.
+    """
+
+    matrix_deg_h_g: FloatArray
+    sigma_deg_h_g: FloatArray
+    bias_deg_h: FloatArray
+    reduced_chi2: FloatArray
+    dof: int
+    n_poses: int
+    design_cond: float
+
+    @property
+    def significant(self) -> npt.NDArray[np.bool_]:
+        """Elements of ``A`` beyond :data:`SIGNIFICANT_SIGMA` σ from 0 (3×3 booleans)."""
+        with np.errstate(divide="ignore", invalid="ignore"):
+            z = np.abs(self.matrix_deg_h_g) / self.sigma_deg_h_g
+        out: npt.NDArray[np.bool_] = np.asarray(z > SIGNIFICANT_SIGMA)
+        return out
+
+    def to_dict(self, per_deg_h: float = 1.0, unit: str = "deg/h") -> dict[str, Any]:
+        """The estimate as JSON types, in the gyro's unit per g.
+
+        Parameters
+        ----------
+        per_deg_h : float, optional
+            The gyro unit's value of 1 °/h (1.0: °/h).
+        unit : str, optional
+            That unit's name.
+
+        Returns
+        -------
+        dict
+            ``matrix`` and ``matrix_sigma`` (rows: gyro axis x, y, z; columns: specific force
+            along x, y, z) in ``unit`` per g, ``unit``, ``bias`` at zero specific force,
+            ``significant`` (3×3 booleans), ``reduced_chi2`` per axis (None without a degree
+            of freedom), ``dof``, ``n_poses``, ``design_cond``.
+        """
+        chi = [None if not math.isfinite(float(c)) else float(c) for c in self.reduced_chi2]
+        return {
+            "matrix": (self.matrix_deg_h_g * per_deg_h).tolist(),
+            "matrix_sigma": (self.sigma_deg_h_g * per_deg_h).tolist(),
+            "unit": f"{unit}/g",
+            "bias": (self.bias_deg_h * per_deg_h).tolist(),
+            "significant": self.significant.tolist(),
+            "reduced_chi2": chi,
+            "dof": self.dof,
+            "n_poses": self.n_poses,
+            "design_cond": self.design_cond,
+        }
+
+
+def _noise_var(
+    n_samples: FloatArray, rate_sigma_rad_s: FloatArray, up: FloatArray, latitude_deg: float | None
+) -> FloatArray:
+    """Each pose's variance per axis [rad²/s²]: white noise and the horizontal earth rate."""
+    om = units.EARTH_RATE_RAD_S
+    if latitude_deg is None:
+        earth = np.full(up.shape, om**2 / 3.0)
+    else:
+        cl = math.cos(math.radians(latitude_deg))
+        earth = (om * cl) ** 2 * (1.0 - up**2) / 2.0
+    out: FloatArray = rate_sigma_rad_s[None, :] ** 2 / n_samples[:, None] + earth
+    return out
+
+
+def fit_g_sensitivity(
+    rate_means_rad_s: npt.ArrayLike,
+    n_samples: npt.ArrayLike,
+    rate_sigma_rad_s: npt.ArrayLike,
+    specific_force_g: npt.ArrayLike,
+    latitude_deg: float | None = None,
+) -> GSensitivity:
+    """The gyro's g-sensitivity matrix ``A`` and its σ from static poses, eq. (1).
+
+    Parameters
+    ----------
+    rate_means_rad_s : array_like, shape (m, 3)
+        Mean rate of each static pose [rad/s].
+    n_samples : array_like, shape (m,)
+        Samples per pose.
+    rate_sigma_rad_s : array_like, shape (3,)
+        Per-sample white-noise σ of each gyro axis [rad/s].
+    specific_force_g : array_like, shape (m, 3)
+        Each pose's calibrated specific force in body axes [g] (at rest: the up direction
+        times the local gravity over standard gravity).
+    latitude_deg : float, optional
+        Latitude [°]: the vertical earth rate is taken off and the horizontal one counted as
+        noise; None counts the whole earth rate as noise of unknown direction.
+
+    Returns
+    -------
+    GSensitivity
+        ``A`` [°/h/g], its σ, the bias at zero specific force [°/h], each axis's reduced χ².
+
+    Raises
+    ------
+    thermocal.errors.DesignError
+        Fewer than :data:`MIN_POSES` poses, or poses whose gravity directions do not span
+        the three axes (condition number beyond :data:`MAX_DESIGN_COND`).
+
+    Notes
+    -----
+    Per gyro axis i, whitened by each pose's noise σ_ki (module docstring):
+
+    .. math::
+
+        \\min_{b_i, A_i} \\sum_k \\frac{(\\bar\\omega_{ki} - \\Omega \\sin L\\, u_{ki}
+        - b_i - A_i f_k)^2}{\\sigma_{ki}^2}, \\qquad
+        \\operatorname{cov} = (X^\\top W X)^{-1} \\max(1, \\chi^2_\\nu)
+
+    the χ² factor applied when the scatter is beyond the noise (5 % level).
+
+    References
+    ----------
+    - IEEE Std 952-1997, *IEEE Standard Specification Format Guide and Test Procedure for
+      Single-Axis Interferometric Fiber Optic Gyros*, annex B (acceleration-sensitive drift).
+    - IEEE Std 1431-2004, *IEEE Standard Specification Format Guide and Test Procedure for
+      Coriolis Vibratory Gyros*.
+    - G. H. Golub and C. F. Van Loan, *Matrix Computations*, 4th ed., §5.3.
+
+    Examples
+    --------
+    Six faces; the x gyro reads 360 °/h per g along z (latitude 0; noise-free means):
+
+    >>> import numpy as np
+    >>> up = np.vstack([np.eye(3), -np.eye(3)])
+    >>> a = np.zeros((3, 3)); a[0, 2] = 360.0
+    >>> w = (up @ a.T + [10.0, 0.0, 0.0]) * np.pi / 180 / 3600
+    >>> gs = fit_g_sensitivity(w, np.full(6, 1000), np.full(3, 1e-3), up, latitude_deg=0.0)
+    >>> round(float(gs.matrix_deg_h_g[0, 2]), 3), round(float(gs.bias_deg_h[0]), 3)
+    (360.0, 10.0)
+    """
+    w = np.asarray(rate_means_rad_s, dtype=np.float64).reshape(-1, 3)
+    n = np.asarray(n_samples, dtype=np.float64).ravel()
+    sig = np.asarray(rate_sigma_rad_s, dtype=np.float64).ravel()
+    f = np.asarray(specific_force_g, dtype=np.float64).reshape(-1, 3)
+    m = w.shape[0]
+    if m < MIN_POSES:
+        raise DesignError(
+            f"the gyro's g-sensitivity needs at least {MIN_POSES} static poses (a bias and "
+            f"three sensitivities per axis), got {m}"
+        )
+    norm = np.linalg.norm(f, axis=1, keepdims=True)
+    up = f / np.where(norm > 0, norm, 1.0)
+    x = np.column_stack([np.ones(m), f])
+    scale = np.linalg.norm(x, axis=0)
+    s = np.linalg.svd(x / np.where(scale > 0, scale, 1.0), compute_uv=False)
+    cond = float(s[0] / s[-1]) if s[-1] > 0 else math.inf
+    if not cond <= MAX_DESIGN_COND:
+        raise DesignError(
+            f"the gyro's g-sensitivity is not separable from these {m} poses: their gravity "
+            f"directions do not span the three axes (design condition number {cond:.3g}); "
+            "add poses with gravity along each axis in both senses (the six faces)"
+        )
+    y = w.copy()
+    if latitude_deg is not None:
+        y = y - units.EARTH_RATE_RAD_S * math.sin(math.radians(latitude_deg)) * up
+    var = _noise_var(n, sig, up, latitude_deg)
+    to_dh = 1.0 / units.DH_TO_RS
+    fits = [_solve_axis(x, y[:, i], var[:, i]) for i in range(3)]
+    coef = np.array([c for c, _, _ in fits]) * to_dh
+    sd = np.array([s for _, s, _ in fits]) * to_dh
+    chi = np.array([c for _, _, c in fits])
+    return GSensitivity(coef[:, 1:], sd[:, 1:], coef[:, 0], chi, m - 4, m, cond)
+
+
+def _solve_axis(
+    x: FloatArray, y: FloatArray, var: FloatArray
+) -> tuple[FloatArray, FloatArray, float]:
+    """One axis's weighted least squares by QR: coefficients, their σ (scaled by a reduced χ²
+    beyond the noise at the 5 % level) and the reduced χ² (NaN without a degree of freedom)."""
+    wt = 1.0 / np.sqrt(var)
+    q, r = np.linalg.qr(x * wt[:, None])
+    c = np.linalg.solve(r, q.T @ (y * wt))
+    rinv = np.linalg.solve(r, np.eye(x.shape[1]))
+    cov = rinv @ rinv.T
+    dof = x.shape[0] - x.shape[1]
+    chi = math.nan
+    if dof > 0:
+        res = (y - x @ c) * wt
+        chi = float(res @ res) / dof
+        from scipy.stats import chi2
+
+        if chi > chi2.ppf(0.95, dof) / dof:
+            cov = cov * chi
+    return c, np.sqrt(np.diag(cov)), chi
+
+
+__all__ = ["MAX_DESIGN_COND", "MIN_POSES", "SIGNIFICANT_SIGMA", "GSensitivity", "fit_g_sensitivity"]

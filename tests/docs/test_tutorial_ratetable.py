@@ -1,0 +1,55 @@
+"""The rate-table tutorial (``docs/tutorials/ratetable.md``) runs as written: every block in
+order in an empty folder, what it prints equal to the page's ``text`` block, and its figures
+the simulated truth (``thermocal.simulate.scenarios.RATETABLE_ERRORS``: 40 ppm/°C, a 0.015 °/s
+dead zone) and a least-squares line computed here (numpy.polyfit)."""
+
+from __future__ import annotations
+
+import json
+import re
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from tutorial_pages import _numbers, _run_in_scratch
+
+PAGE = "ratetable.md"
+
+
+@pytest.fixture(scope="module")
+def page(tmp_path_factory: pytest.TempPathFactory) -> tuple[list[tuple[str, str]], Path]:
+    tmp = tmp_path_factory.mktemp("ratetable")
+    return _run_in_scratch(tmp, PAGE), tmp
+
+
+def test_ratetable_tutorial_prints_what_the_page_shows(
+    page: tuple[list[tuple[str, str]], Path],
+) -> None:
+    pairs, _ = page
+    assert len(pairs) == 4
+    for printed, shown in pairs:
+        assert _numbers(printed) == _numbers(shown)
+        lines = [ln.rstrip() for ln in printed.strip().splitlines()]
+        assert lines == [ln.rstrip() for ln in shown.strip().splitlines()]
+
+
+def test_ratetable_tutorial_figures_are_the_simulated_truth(
+    page: tuple[list[tuple[str, str]], Path],
+) -> None:
+    pairs, tmp = page
+    truth = json.loads((tmp / "truth.json").read_text())
+    tr = next(f for f in truth["files"] if f["label"] == "T+20")
+    assert "0.01 < · ≤ 0.02" in pairs[1][0] and 0.01 < tr["dead_zone_dps"] <= 0.02
+    w = np.array([p["rate_dps"] for p in tr["plateaus"]])
+    y = np.array(tr["outputs"])
+    keep = np.arange(w.size) != 30  # the plateau cut short, left out
+    k = np.polyfit(w[keep], y[keep], 1)[0]
+    m = re.search(r"scale factor\s+│\s+([\d.]+) ± ([\d.e-]+)", pairs[1][0])
+    assert m is not None and abs(float(m[1]) - k) < 4 * float(m[2])
+    tc = re.search(r"TC = ([\d.]+) ± ([\d.]+) ppm/°C about ([\d.]+)", pairs[2][0])
+    assert tc is not None
+    want = tr["tc_ppm_per_c"] / (1 + tr["tc_ppm_per_c"] * 1e-6 * (float(tc[3]) - 25.0))
+    assert abs(float(tc[1]) - want) < 4 * float(tc[2])
+    a, b = _numbers(pairs[3][0])
+    assert a == b

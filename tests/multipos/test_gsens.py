@@ -1,0 +1,105 @@
+"""The gyro's sensitivity to specific force from static poses (``multipos.gsens``): the six
+faces' half differences written here, the simulator's truth over seeds, the refusals, and
+the command's report on imucal's public Ferraris session."""
+
+from __future__ import annotations
+
+import contextlib
+import io
+import json
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from thermocal.cli import main
+from thermocal.errors import DesignError
+from thermocal.multipos import Section, calibrate_session
+from thermocal.multipos.gsens import fit_g_sensitivity
+from thermocal.multipos.simulate import random_truth, simulate_ferraris
+
+DH = math.pi / 180.0 / 3600.0  # 1 °/h in rad/s
+FERRARIS = Path(__file__).parents[1] / "data" / "imucal_ferraris"
+A_TRUE = np.array([[180.0, -90.0, 36.0], [50.0, -250.0, 120.0], [-30.0, 60.0, 300.0]])
+
+
+def test_six_faces_give_the_half_differences_of_each_pair() -> None:
+    """Each face pair ±j seen with equal weight: A_ij = (ω_i(+j) − ω_i(−j))/2, whatever
+    the bias and the other pairs (the normal equations decouple); computed here."""
+    rng = np.random.default_rng(3)
+    up = np.vstack([np.eye(3), -np.eye(3)])
+    w = rng.normal(0.0, 50.0, (6, 3)) * DH  # arbitrary pose means [rad/s]
+    gs = fit_g_sensitivity(w, np.full(6, 500), np.full(3, 1e-3), up)  # no latitude
+    half = (w[0:3] - w[3:6]).T / 2.0 / DH  # [i, j]: axis i, pair j
+    np.testing.assert_allclose(gs.matrix_deg_h_g, half, rtol=1e-12, atol=1e-9)
+    np.testing.assert_allclose(gs.bias_deg_h, w.mean(axis=0) / DH, rtol=1e-12)
+    assert gs.dof == 2 and gs.n_poses == 6
+
+
+def test_the_vertical_earth_rate_is_not_taken_for_a_sensitivity() -> None:
+    """At latitude L a still gyro reads Ω sin L along up on top of its bias: with the six
+    faces and no sensitivity, A must come out 0 (it would be Ω sin L on the diagonal)."""
+    lat = 48.0
+    up = np.vstack([np.eye(3), -np.eye(3)])
+    om = 7.292115e-5 * math.sin(math.radians(lat))
+    w = up * om + np.array([5.0, -3.0, 1.0]) * DH
+    gs = fit_g_sensitivity(w, np.full(6, 1000), np.full(3, 1e-4), up, latitude_deg=lat)
+    np.testing.assert_allclose(gs.matrix_deg_h_g, 0.0, atol=1e-9)
+
+
+def test_too_few_poses_or_poses_in_one_plane_are_refused() -> None:
+    up = np.vstack([np.eye(3), -np.eye(3)])
+    with pytest.raises(DesignError, match="at least 4 static poses"):
+        fit_g_sensitivity(np.zeros((3, 3)), np.full(3, 100), np.full(3, 1e-3), up[:3])
+    flat = up[[0, 1, 3, 4]]  # gravity along ±x and ±y only: A's z column unseen
+    with pytest.raises(DesignError, match="do not span the three axes"):
+        fit_g_sensitivity(np.zeros((4, 3)), np.full(4, 100), np.full(3, 1e-3), flat)
+
+
+def _session(seed: int) -> tuple[np.ndarray, np.ndarray]:
+    rng = np.random.default_rng(seed)
+    truth, _ = random_truth(rng)
+    s = simulate_ferraris(rng, truth.accel, truth.gyro, g_sensitivity_deg_h_g=A_TRUE)
+    secs = [Section(k, v["start"], v["end"]) for k, v in s["sections"].items()]
+    g_mg = s["g_m_s2"] / 9.80665e-3
+    res = calibrate_session(s["time_s"], s["accel_mg"], np.radians(s["gyro_deg_s"]),
+                            g_mg=g_mg, latitude_deg=45.0, sections=secs)  # fmt: skip
+    gs = res.g_sensitivity
+    assert gs is not None and res.g_sensitivity_note is None
+    return gs.matrix_deg_h_g, gs.sigma_deg_h_g
+
+
+def test_the_simulators_sensitivity_is_recovered_within_its_sigma() -> None:
+    """A Ferraris session as users record it (six faces at random headings, then the three
+    turns; hand tremor, earth rate at 45°) with a known A of up to 300 °/h/g: over 12 seeds
+    every element within 3.5σ, about 95 % within 1.96σ (binomial band for 108 draws)."""
+    z = np.array([((a - A_TRUE) / s).ravel() for a, s in map(_session, range(12))])
+    assert np.all(np.abs(z) < 3.5), np.abs(z).max()
+    inside = float(np.mean(np.abs(z) < 1.96))
+    assert 0.88 <= inside <= 1.0, inside
+    assert 0.7 < float(z.std()) < 1.3
+
+
+def test_multipos_reports_it_on_imucals_session(tmp_path: Path) -> None:
+    """imucal's public Ferraris session (six faces, then three turns): the JSON holds the 3×3
+    matrix in the gyro's unit per g with σ below 0.01 °/s/g, and the text says none is beyond
+    3σ."""
+    args = ["multipos", str(FERRARIS / "example_ferraris_session.csv"),
+            "--poses", str(FERRARIS / "example_ferraris_session_list.json"), "--rate", "102.4",
+            "--accel", "acc_x,acc_y,acc_z", "--accel-unit", "m/s^2",
+            "--gyro", "gyr_x,gyr_y,gyr_z", "--gyro-unit", "deg/s", "--gravity", "9.81"]  # fmt: skip
+    out, err = io.StringIO(), io.StringIO()
+    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+        assert main([*args, "-o", str(tmp_path / "a.json"), "--json"]) == 0
+    gs = json.loads(out.getvalue())["runs"][0]["gyro"]["g_sensitivity"]
+    assert gs["unit"] == "deg/s/g" and gs["n_poses"] == 6 and gs["dof"] == 2
+    m, s = np.array(gs["matrix"]), np.array(gs["matrix_sigma"])
+    assert m.shape == (3, 3) and np.all(s > 0) and np.all(s < 0.01)
+    assert not np.any(gs["significant"]) and np.all(np.abs(m) < 3 * s)
+    out = io.StringIO()
+    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(io.StringIO()):
+        assert main([*args, "-o", str(tmp_path / "b.json")]) == 0
+    assert "gyro g-sensitivity from 6 poses [deg/s/g, gyro/force axis]: none beyond 3σ" in (
+        " ".join(out.getvalue().split())
+    )
