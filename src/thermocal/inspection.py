@@ -207,6 +207,11 @@ class Inspection:
         Time is finite and strictly increasing.
     timestamp_jitter : TimeJitter or None
         The scatter of the time steps.
+    thermometers : dict
+        Per temperature column, what its thermometer is
+        (:meth:`thermocal.thermometer.Thermometer.to_dict`: lattice step, update period,
+        quantised, slow), None when it cannot be told (raw counts without a conversion, no
+        finite value, time not increasing).
     """
 
     file: str
@@ -227,6 +232,8 @@ class Inspection:
     something."""
     timestamp_jitter: TimeJitter | None = None
     """The scatter of the time steps (:func:`thermocal.recording.time_jitter`)."""
+    thermometers: dict[str, dict[str, Any] | None] = field(default_factory=dict)
+    """Per temperature column, its thermometer (:mod:`thermocal.thermometer`)."""
 
     @property
     def fatal(self) -> list[Problem]:
@@ -263,6 +270,7 @@ class Inspection:
             "timestamp_jitter": (
                 self.timestamp_jitter.to_dict() if self.timestamp_jitter is not None else None
             ),
+            "thermometers": self.thermometers,
         }
 
 
@@ -500,7 +508,19 @@ def inspect_recording(rec: Recording, skipped: Sequence[str] = ()) -> Inspection
         problems=problems + _skipped_problems(skipped),
         time_ok=time_ok,
         timestamp_jitter=rec.time_jitter(),
+        thermometers={n: _thermometer(rec, n) for n in span if time_ok and span[n] is not None},
     )
+
+
+def _thermometer(rec: Recording, name: str) -> dict[str, Any] | None:
+    """What the thermometer of column ``name`` is (None: no finite value)."""
+    from thermocal.errors import ParameterError
+    from thermocal.thermometer import describe_thermometer
+
+    try:
+        return describe_thermometer(rec.time_s, rec.temperature_c(name)).to_dict()
+    except ParameterError:
+        return None
 
 
 def _skipped_problems(skipped: Sequence[str]) -> list[Problem]:

@@ -485,15 +485,22 @@ ATTACKS: list[Attack] = [
     _r("ardupilot-tempcal/instance-5-only", ("ardupilot-tempcal", "{d}/l.bin", "-o", "{d}/out"),
        {"l.bin": lambda: _dataflash(lambda r: [(x[0], 5, *x[2:]) for x in r])},
        "instance 0"),
+    _r("px4-tempcal/temps-from-missing", ("px4-tempcal", "{d}/l.ulg", "-o", "{d}/out",
+       "--temps-from", "3"), {"l.ulg": _ulog()}, "--temps-from names sensor_gyro"),
+    _r("px4-tempcal/temperature-unknown", ("px4-tempcal", "{d}/l.ulg", "-o", "{d}/out",
+       "--temperature", "smooth"), {"l.ulg": _ulog()}, "give reconstructed or raw"),
+    _r("ardupilot-tempcal/temps-from-missing", ("ardupilot-tempcal", "{d}/l.bin", "-o",
+       "{d}/out", "--temps-from", "baro"), {"l.bin": lambda: _dataflash(lambda r: r)},
+       "--temps-from names BARO.0"),
 ]
 
 
 def test_the_table_keeps_every_row() -> None:
     """The audit's counts (this file's rows; the report of issue 39 quotes them)."""
-    assert len({a.id for a in ATTACKS}) == len(ATTACKS) == 110
-    assert Counter(a.expect for a in ATTACKS) == {"refuse": 98, "warn": 4, "valid": 8}
+    assert len({a.id for a in ATTACKS}) == len(ATTACKS) == 113
+    assert Counter(a.expect for a in ATTACKS) == {"refuse": 101, "warn": 4, "valid": 8}
     assert Counter(a.before for a in ATTACKS) == {
-        "refuse": 76,
+        "refuse": 79,
         "valid": 7,
         "warn": 3,
         "vague": 6,
@@ -512,8 +519,8 @@ def test_the_table_keeps_every_row() -> None:
         "simulate": 9,
         "profile": 2,
         "demo": 4,
-        "px4-tempcal": 6,
-        "ardupilot-tempcal": 5,
+        "px4-tempcal": 8,
+        "ardupilot-tempcal": 6,
     }
 
 

@@ -158,7 +158,8 @@ def test_the_shipped_logs_are_what_their_script_makes() -> None:
 
 def test_fc_tutorial_prints_what_the_page_shows(fc_page: tuple[Path, Page]) -> None:
     _, page = fc_page
-    assert [codes for _p, _s, codes in page] == [[0], [], [0], [0], [0]]  # the last: heated
+    # the fifth: heated; the sixth: the thermometers' python block
+    assert [codes for _p, _s, codes in page] == [[0], [], [0], [0], [0], []]
     for printed, shown, _codes in page:
         assert _numbers(printed) == _numbers(shown)
         assert _lines(printed) == _lines(shown)

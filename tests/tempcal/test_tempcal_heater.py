@@ -164,6 +164,31 @@ def test_ardupilot_heater_off_mid_log(tmp_path: Path, capsys: pytest.CaptureFixt
     assert any("IMU.0: heater hold" in n and "heater off at" in n for n in json.loads(out)["notes"])
 
 
+def test_ardupilot_hold_judged_on_the_reconstructed_temperature(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """ArduPilot, an IMU reading whole degrees: the hold is judged on the temperature the fits
+    take (reconstructed by default: the set-point reached within 2 s of the simulator's
+    instant, 1.5 s), the same for the gyro and the accelerometer; as logged
+    (``--temperature raw``) the first whole-degree reading of 55 °C comes 8.9 s early."""
+    tr = heated_truth(3)
+    tr["temp"] = np.round(tr["temp"])
+    log = tmp_path / "whole.bin"
+    log.write_bytes(heated_dataflash(tr, {"BRD_HEAT_TARG": 55.0}))
+    reached = {}
+    for mode in ("reconstructed", "raw"):
+        code, out, err = run(["ardupilot-tempcal", str(log), "-o", str(tmp_path / mode),
+                              "--json", "--heater-min-hold", "120", "--temperature", mode],
+                             capsys)  # fmt: skip
+        assert code == 0, err
+        sensors = json.loads(out)["sensors"]
+        assert sensors["IMU.Gyr.0"]["heater"] == sensors["IMU.Acc.0"]["heater"]
+        assert sensors["IMU.Gyr.0"]["thermometer"]["temperature"] == mode
+        reached[mode] = sensors["IMU.Gyr.0"]["heater"]["reached_s"]
+    assert abs(reached["reconstructed"] - tr["reached_s"]) < 2.0
+    assert abs(reached["raw"] - tr["reached_s"]) > 5.0
+
+
 def test_ardupilot_old_parameter_name_and_heater_disabled(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
@@ -231,20 +256,31 @@ def test_hostile_heater_options(
 def test_whole_degree_thermometer_with_a_wider_band(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    """A thermometer that reads whole degrees (some Bosch parts): the set-point is reached
-    within half a degree's step of the ramp (0.5 °C / 0.06 °C/s = 8.3 s), and the band
-    held reads as whole degrees."""
+    """A thermometer that reads whole degrees (some Bosch parts).  As logged
+    (``--temperature raw``): the set-point is reached within half a degree's step of the
+    ramp (0.5 °C / 0.06 °C/s = 8.3 s), and the band held reads as whole degrees.  The hold
+    is judged on the temperature the fit uses: reconstructed (the default), the set-point
+    is reached within 2 s of the simulator's instant (1.5 s; as logged with the default
+    band: 8.9 s early) and held within the default ±0.5 °C band."""
     tr = heated_truth(3)
     tr["temp"] = np.round(tr["temp"])
     log = tmp_path / "whole.ulg"
     log.write_bytes(heated_ulog(tr, PX4_HEATER))
     code, out, err = run(["px4-tempcal", str(log), "-o", str(tmp_path / "o"), "--json",
-                          "--heater-band", "1", "--heater-min-hold", "120"], capsys)  # fmt: skip
+                          "--heater-band", "1", "--heater-min-hold", "120",
+                          "--temperature", "raw"], capsys)  # fmt: skip
     assert code == 0, err
     hold = json.loads(out)["sensors"]["sensor_gyro.0"]["heater"]
     assert hold["band_c"] == 1.0 and hold["hold_s"] >= 120.0
     assert abs(hold["reached_s"] - tr["reached_s"]) < 0.5 / 0.06 + 0.5
     assert all(float(v).is_integer() for v in hold["held_c"])
+    code, out, err = run(["px4-tempcal", str(log), "-o", str(tmp_path / "r"), "--json",
+                          "--heater-min-hold", "120"], capsys)  # fmt: skip
+    assert code == 0, err
+    hold = json.loads(out)["sensors"]["sensor_gyro.0"]["heater"]
+    assert hold["band_c"] == 0.5 and hold["hold_s"] >= 120.0
+    assert abs(hold["reached_s"] - tr["reached_s"]) < 2.0
+    assert -0.5 <= hold["held_c"][0] <= hold["held_c"][1] <= 0.5
     for option, value in (("--heater-band", "0"), ("--heater-min-hold", "-1")):
         code, _o, err = run(["px4-tempcal", str(log), "-o", str(tmp_path / "x"), option, value],
                             capsys)  # fmt: skip

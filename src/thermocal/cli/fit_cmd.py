@@ -283,6 +283,17 @@ def fit_cmd(**values: Any) -> None:
     emit(result.to_dict(), as_json, lambda: _human_single(ch.model, ch.figures, ch.n_runs, output))
 
 
+TemperatureModeOpt = Annotated[
+    str,
+    typer.Option(
+        "--temperature",
+        help="reconstructed: a quantised or slow thermometer (a lattice of 0.1 °C or more, "
+        "updated every second or slower) is fitted on the temperature reconstructed at each "
+        "sample; raw: on its reading as logged.",
+    ),
+]
+
+
 KW = inspect.Parameter.KEYWORD_ONLY
 _EMPTY = inspect.Parameter.empty
 _COMMON_FIRST = (
@@ -302,7 +313,7 @@ _COMMON_LAST = (
     ("heater", HeaterOpt, "cut"), ("heater_setpoint", HeaterSetpointOpt, None),
     ("heater_band", HeaterBandOpt, 0.5), ("heater_min_hold", HeaterMinHoldOpt, 60.0),
     ("param", ParamOpt, None),
-    ("as_json", JsonOpt, False),
+    ("temperature", TemperatureModeOpt, "reconstructed"), ("as_json", JsonOpt, False),
 )  # fmt: skip
 """The options of ``fit`` every family shares, around the families' own."""
 

@@ -8,7 +8,7 @@ The library does the work (:func:`thermocal.tempcal.px4.px4_tempcal`,
 """
 
 from pathlib import Path
-from typing import TYPE_CHECKING, Annotated
+from typing import TYPE_CHECKING, Annotated, Literal
 
 import typer
 
@@ -33,8 +33,27 @@ if TYPE_CHECKING:
     from thermocal.heater import HeaterOptions
     from thermocal.tempcal.ardupilot import ArdupilotTempcalResult
     from thermocal.tempcal.px4 import Px4TempcalResult
+    from thermocal.tempcal.thermometers import TempsFrom
 
 OutDirOpt = Annotated[Path, typer.Option("-o", "--output", help="Directory to write.")]
+TemperatureOpt = Annotated[
+    str,
+    typer.Option(
+        "--temperature",
+        help="reconstructed: a quantised or slow thermometer (a lattice of 0.1 °C or more, "
+        "updated every second or slower) is fitted on the temperature reconstructed at each "
+        "sample; raw: on its reading as logged.",
+    ),
+]
+TempsFromOpt = Annotated[
+    str | None,
+    typer.Option(
+        "--temps-from",
+        help="Calibrate against another thermometer, joined by time: N (IMU instance N's), "
+        "baro (the first barometer's); TARGETS=SOURCE for some instances only, e.g. 0=1 or "
+        "0,2=baro (default: every instance its own).",
+    ),
+]
 EmulateOpt = Annotated[
     bool,
     typer.Option(
@@ -44,6 +63,53 @@ EmulateOpt = Annotated[
         "thermocal's fit (and, for ArduPilot, its TCLR points against the log's).",
     ),
 ]
+
+
+def parse_temps_from(text: str | None) -> "TempsFrom | None":
+    """``"1"``, ``"baro"``, ``"0=1"``, ``"0,2=baro"`` → :class:`TempsFrom`.
+
+    Parameters
+    ----------
+    text : str or None
+        The option's text.
+
+    Returns
+    -------
+    TempsFrom or None
+
+    Raises
+    ------
+    ThermocalInputError
+        Not of that form.
+    """
+    from thermocal.errors import ThermocalInputError
+    from thermocal.tempcal.thermometers import TempsFrom
+
+    if text is None:
+        return None
+    targets_text, _eq, source_text = text.strip().rpartition("=")
+    source_text = source_text.strip().lower()
+    try:
+        source: int | str = "baro" if source_text == "baro" else int(source_text)
+        targets = (
+            tuple(int(t) for t in targets_text.split(",")) if _eq else None
+        )  # fmt: skip
+    except ValueError:
+        raise ThermocalInputError(
+            f"--temps-from {text!r}: give an instance number, baro, or TARGETS=SOURCE "
+            "(e.g. 1, baro, 0=1, 0,2=baro)"
+        ) from None
+    return TempsFrom(source, targets)  # type: ignore[arg-type]
+
+
+def _temperature_mode(text: str) -> "Literal['reconstructed', 'raw']":
+    """``--temperature``'s text checked."""
+    from thermocal.errors import ThermocalInputError
+
+    low = text.strip().lower()
+    if low not in ("reconstructed", "raw"):
+        raise ThermocalInputError(f"--temperature {text!r}: give reconstructed or raw")
+    return "raw" if low == "raw" else "reconstructed"
 
 
 def heater_options(
@@ -101,6 +167,8 @@ def px4_tempcal_cmd(
     heater_band: HeaterBandOpt = 0.5,
     heater_min_hold: HeaterMinHoldOpt = 60.0,
     emulate_learning: EmulateOpt = False,
+    temperature: TemperatureOpt = "reconstructed",
+    temps_from: TempsFromOpt = None,
 ) -> None:
     """Fit every gyro and accelerometer instance of a PX4 log as PX4 would (a cubic per axis
     about TREF), robust to spikes, with equal weight across the temperature range and
@@ -114,6 +182,7 @@ def px4_tempcal_cmd(
         log, output, tref_c=tref, overrides=overrides_of(allow_narrow, allow_motion),
         reporter=write_sensor_report, allan=allan, emulate_learning=emulate_learning,
         heater=heater_options(heater, heater_setpoint, heater_band, heater_min_hold),
+        temperature=_temperature_mode(temperature), temps_from=parse_temps_from(temps_from),
     )  # fmt: skip
     emit(res.to_dict(), as_json, lambda: _print_px4(res))
 
@@ -148,6 +217,8 @@ def ardupilot_tempcal_cmd(
     heater_band: HeaterBandOpt = 0.5,
     heater_min_hold: HeaterMinHoldOpt = 60.0,
     emulate_learning: EmulateOpt = False,
+    temperature: TemperatureOpt = "reconstructed",
+    temps_from: TempsFromOpt = None,
 ) -> None:
     """ArduPilot's thermal calibration from one DataFlash log: every IMU instance's gyro
     and accelerometer fitted as in px4-tempcal, written as INS_TCAL* (.parm), a calibration
@@ -161,6 +232,7 @@ def ardupilot_tempcal_cmd(
         log, output, overrides=overrides_of(allow_narrow, allow_motion),
         reporter=write_sensor_report, allan=allan, emulate_learning=emulate_learning,
         heater=heater_options(heater, heater_setpoint, heater_band, heater_min_hold),
+        temperature=_temperature_mode(temperature), temps_from=parse_temps_from(temps_from),
     )  # fmt: skip
     emit(res.to_dict(), as_json, lambda: _print_ardupilot(res))
 

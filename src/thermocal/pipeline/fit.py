@@ -788,6 +788,38 @@ def _check_options(paths: Sequence[Path], o: FitOptions, output: Path) -> dict[s
     return options
 
 
+def _thermometers(
+    loaded: list[tuple[Path, _recording.Recording]], o: FitOptions
+) -> tuple[list[tuple[Path, _recording.Recording]], list[dict[str, Any]]]:
+    """Each run's temperature columns with a quantised or slow thermometer reconstructed
+    (``o.temperature``; :func:`thermocal.thermometer.reconstruct_columns`), each one
+    reconstructed said in a warning; what every column's thermometer is."""
+    from thermocal.thermometer import ThermometerWarning, reconstruct_columns
+
+    out, said = [], []
+    for path, rec in loaded:
+        names = run_temp_names(rec, o.temperatures)
+        rec, rows = reconstruct_columns(rec, names, mode=o.temperature)
+        for r in rows:
+            if r["temperature"] == "reconstructed":
+                warnings.warn(
+                    ThermometerWarning.naming(
+                        f"{path}: {r['column']!r}: {r['note']}; give {{temperature}} raw to "
+                        "fit it as logged",
+                        "temperature",
+                    ),
+                    stacklevel=3,
+                )
+        out.append((path, rec))
+        said.extend(rows)
+    return out, said
+
+
+def _recorded(thermo: list[dict[str, Any]]) -> list[dict[str, Any]]:
+    """What the model file keeps of each run's thermometers (not the file's path)."""
+    return [{k: v for k, v in r.items() if k != "file"} for r in thermo]
+
+
 def fit_files(paths: Sequence[Path], options: FitOptions, output: Path) -> FitResult:
     """Fit ``options.model`` on the recordings ``paths`` (one run each) and save it to
     ``output`` (module docstring).  Options are checked before any file is read
@@ -832,6 +864,9 @@ def fit_files(paths: Sequence[Path], options: FitOptions, output: Path) -> FitRe
             f"{{name}} applies to the poly family (coefficients about TREF), not {o.model!r}",
         )
     _distinct_runs([path for path, _rec in loaded])
+    # the thermometer first: the heater's hold is judged (and thinned) on the temperature
+    # the fit uses, and the reconstruction needs every sample (its update period)
+    loaded, thermo = _thermometers(loaded, o)
     loaded, holds, said = _heater_holds(loaded, o)
     spec = _FitSpec(o.model, family_options, o.temperatures, o.latitude, o.axis, o.known_input,
                     o.target, o.gravity_axis, g_local, o.tref,
@@ -839,11 +874,15 @@ def fit_files(paths: Sequence[Path], options: FitOptions, output: Path) -> FitRe
                     overrides_of(o.allow_narrow, o.allow_motion))  # fmt: skip
     if len(names) <= 1:
         est, result, n_runs = _fit_channel(spec, loaded, names[0] if names else None)
+        est.inputs_ = {**(est.inputs_ or {}), "thermometers": _recorded(thermo)}
         _files.save_model(est, output)
         result["output"], result["heater"] = str(output), holds
+        result["thermometers"] = thermo
         result["warnings"] = [*said, *result["warnings"]]
         return FitResult(output, (FittedChannel(est.signal_name, est, result, n_runs),), False)
     fitted = _fit_channels(spec, loaded, names)
+    for _name, est, _res, _n in fitted:
+        est.inputs_ = {**(est.inputs_ or {}), "thermometers": _recorded(thermo)}
     cal = _calibration.Calibration(
         [
             _calibration.Channel(
@@ -857,8 +896,9 @@ def fit_files(paths: Sequence[Path], options: FitOptions, output: Path) -> FitRe
         ]
     )
     _files.save_calibration(cal, output)
+    extra = {"heater": holds, "thermometers": thermo}
     channels = tuple(
-        FittedChannel(name, est, {**res, "heater": holds, "warnings": [*said, *res["warnings"]]}, n)
+        FittedChannel(name, est, {**res, **extra, "warnings": [*said, *res["warnings"]]}, n)
         for name, est, res, n in fitted
     )
     return FitResult(output, channels, True)

@@ -108,11 +108,16 @@ class FitOptions:
         whose plateau is what it models).
     heater_band, heater_min_hold : float
         The hold's half-width [°C] (default 0.5) and shortest duration [s] (default 60).
+    temperature : {"reconstructed", "raw"}
+        A quantised or slow thermometer (:mod:`thermocal.thermometer`: a lattice of 0.1 °C or
+        more, or updated every second or slower) fitted on the temperature reconstructed at
+        each sample (default), or on its reading as logged.
 
     Raises
     ------
     thermocal.errors.ParameterError
-        A target, column list, temperature conversion or heater policy no fit can use,
+        A target, column list, temperature conversion, heater policy or temperature mode no
+        fit can use,
         naming the field.
 
     Examples
@@ -155,9 +160,14 @@ class FitOptions:
     heater_setpoint: float | None = None
     heater_band: float = 0.5
     heater_min_hold: float = 60.0
+    temperature: Literal["reconstructed", "raw"] = "reconstructed"
 
     def __post_init__(self) -> None:
         set_ = object.__setattr__  # frozen: normalise in place once
+        if self.temperature not in ("reconstructed", "raw"):
+            raise ParameterError(
+                "temperature", f"{{name}} must be reconstructed or raw, got {self.temperature!r}"
+            )
         if self.heater not in ("cut", "refuse", "ignore"):
             raise ParameterError(
                 "heater", f"{{name}} must be cut, refuse or ignore, got {self.heater!r}"

@@ -434,7 +434,7 @@ def imu_noise_text(where: str, res: ImuNoise) -> list[Block]:
 def inspection_text(r: Inspection) -> list[Block]:
     """What a recording holds: samples, duration, sample rate, gaps and segments (or why
     they are not computed), a table of each column's role, unit, range, mean, NaN and
-    spikes, and the first ten gaps.
+    spikes, a quantised or slow thermometer, and the first ten gaps.
 
     Parameters
     ----------
@@ -462,6 +462,12 @@ def inspection_text(r: Inspection) -> list[Block]:
     rows = tuple((c.name, c.role, c.unit, fmt(c.min, 6), fmt(c.max, 6), fmt(c.mean, 6),
                   str(c.n_nan), str(c.n_spikes)) for c in r.columns.values())  # fmt: skip
     out: list[Block] = [head, TextTable(None, columns, rows, ("left",) * len(columns))]
+    for name, th in r.thermometers.items():
+        if th is not None and (th["quantised"] or th["slow"]):
+            out.append(
+                f"temperature {name!r}: the thermometer is {th['kind']}; fit, px4-tempcal "
+                "and ardupilot-tempcal fit on the temperature reconstructed at each sample"
+            )
     if r.gaps:
         out.append(
             "gaps (start s, length s): "

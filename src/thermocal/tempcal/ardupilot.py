@@ -31,7 +31,7 @@ from thermocal.firmware.ardupilot import (
     tclr_learned,
 )
 from thermocal.firmware.formats import AP_TREF_C, FORMATS
-from thermocal.heater import HeaterOptions
+from thermocal.heater import HeaterJudgement, HeaterOptions
 from thermocal.models.calibration import Calibration
 from thermocal.outputs import check_outputs
 from thermocal.recording import FloatArray, Recording
@@ -63,6 +63,14 @@ from thermocal.tempcal.pipeline import (
     step_warnings,
     summary,
     warn_gates,
+)
+from thermocal.tempcal.thermometers import (
+    TemperatureMode,
+    TempsFrom,
+    ThermometerPlan,
+    ardupilot_plan,
+    record_thermometer,
+    sensor_temperature,
 )
 
 MAX_IMUS = 3
@@ -767,6 +775,8 @@ class _Run:
     emulate: bool = False
     """The firmware's in-flight learning is emulated on each IMU."""
     emulated: dict[str, ArdupilotEmulation] = dataclasses.field(default_factory=dict)
+    plan: ThermometerPlan = dataclasses.field(default_factory=ThermometerPlan)
+    """The temperature each IMU is fitted on (:mod:`.thermometers`)."""
 
 
 def ardupilot_tempcal(
@@ -778,6 +788,8 @@ def ardupilot_tempcal(
     allan: bool = False,
     heater: HeaterOptions | None = None,
     emulate_learning: bool = False,
+    temperature: TemperatureMode = "reconstructed",
+    temps_from: TempsFrom | None = None,
 ) -> ArdupilotTempcalResult:
     """ArduPilot's thermal calibration of every IMU of a DataFlash log, written as one set.
 
@@ -799,9 +811,16 @@ def ardupilot_tempcal(
         default False: left out (on a long log, most of a report's cost).
     heater : HeaterOptions, optional
         The heater's hold (:class:`thermocal.heater.HeaterOptions`; default: the set-point
-        ``BRD_HEAT_TARG``/``BRD_IMU_TARGTEMP`` unless −1, else inferred).
+        ``BRD_HEAT_TARG``/``BRD_IMU_TARGTEMP`` unless −1, else inferred), looked for in
+        the temperature fitted on (``temperature``, ``temps_from``).
     emulate_learning : bool, optional
         Also emulate the firmware's learning on each IMU (:mod:`thermocal.tempcal.learning`).
+    temperature : {"reconstructed", "raw"}, optional
+        A quantised or slow thermometer (:mod:`thermocal.thermometer`) is fitted on the
+        temperature reconstructed at each sample (default), or on its reading as logged.
+    temps_from : TempsFrom, optional
+        Calibrate against another IMU's (or ``BARO`` 0's) thermometer, joined by time
+        (:func:`.thermometers.sensor_temperature`); default each IMU its own.
 
     Returns
     -------
@@ -833,38 +852,51 @@ def ardupilot_tempcal(
       https://github.com/ArduPilot/ardupilot/blob/master/libraries/AP_InertialSensor/AP_InertialSensor_tempcal.cpp
     * ArduPilot, ``libraries/AP_TempCalibration/AP_TempCalibration.cpp`` (the barometer).
     """
-    from thermocal.export.params import ParamSet, check_documented, check_values
+    from thermocal.export.params import ParamSet
 
-    # DIR may hold the log; the files of the set (replaced by name) may not be it
-    names = ["calibration.json", FORMATS["ardupilot"].params_file, BARO_REPORT]
-    names += [f"report_IMU_{i}_{k}.html" for i in range(MAX_IMUS) for k in ("gyro", "accel")]
-    check_outputs([output / n for n in names], [log], dirs=[output])
-    check_output_dir(output)
+    _check_set(log, output)
     with (
         report_worker(reporter, log) as pool,  # starts while the log is read
         staged_set(output, reporter, pool) as out_set,  # moved into place whole, or removed
     ):
         flight = read_ardupilot_log(log, MESSAGES)  # the log is read once, passed down
         run = _Run(log, flight, overrides, ParamSet("ardupilot"), out_set, [], [], {}, {})
-        run.allan, run.heater = allan, heater or HeaterOptions()
-        run.emulate = emulate_learning
+        run.allan, run.heater, run.emulate = allan, heater or HeaterOptions(), emulate_learning
+        run.plan = ardupilot_plan(flight, temperature, temps_from)
         _imus(run)
         if not run.fits:
             raise ThermocalInputError(f"{log}: no IMU with a usable temperature in the log")
-        _baro(run)
-        run.gates.extend(step_warnings(run.fits, run.series, run.motions))
-        warn_gates(run.gates)
-        check_values(run.params)
-        check_documented(run.params)
-        out_set.commit(
-            calibration_of(run.fits), FORMATS["ardupilot"].params_file, run.params.text()
-        )
+        _commit(run)
     return ArdupilotTempcalResult(
         log, output / FORMATS["ardupilot"].params_file, output / "calibration.json",
         tuple(out_set.reports), tuple(run.fits), tuple(_run_notes(run)), run.orientation,
         run.hygiene, run.previous, run.learning, run.baro, run.rotated, _changes_said(run),
         run.emulated,
     )  # fmt: skip
+
+
+def _check_set(log: Path, output: Path) -> None:
+    """Refuse an output set that would overwrite the log (DIR may hold the log; the files of
+    the set, replaced by name, may not be it) or that is not a directory."""
+    names = ["calibration.json", FORMATS["ardupilot"].params_file, BARO_REPORT]
+    names += [f"report_IMU_{i}_{k}.html" for i in range(MAX_IMUS) for k in ("gyro", "accel")]
+    check_outputs([output / n for n in names], [log], dirs=[output])
+    check_output_dir(output)
+
+
+def _commit(run: _Run) -> None:
+    """The end of a run once its IMUs are fitted: the barometer, the step warnings across
+    instances, the gates said, the parameters checked and the set committed."""
+    from thermocal.export.params import check_documented, check_values
+
+    _baro(run)
+    run.gates.extend(step_warnings(run.fits, run.series, run.motions))
+    warn_gates(run.gates)
+    check_values(run.params)
+    check_documented(run.params)
+    run.out_set.commit(
+        calibration_of(run.fits), FORMATS["ardupilot"].params_file, run.params.text()
+    )
 
 
 def _run_notes(run: _Run) -> list[str]:
@@ -1020,13 +1052,10 @@ def _imu(run: _Run, data: _ImuData) -> None:
 
     assert data.time_s is not None and data.temp_c is not None
     inst, time_s = data.inst, data.time_s
-    temp_c: FloatArray = data.temp_c.astype(np.float64)  # exact: see _compact
-    held = judge_instance(
-        f"{run.log}: IMU.{inst}", time_s, temp_c, run.flight.parameters, "ardupilot", run.heater
-    )
-    run.gates.extend(held.warnings)
-    if held.hold is None or held.hold.setpoint_source == "inferred":  # a stall, or a heater?
-        run.gates.append(stall_warning(f"IMU.{inst}", time_s, temp_c))
+    # the IMU's thermometer as logged (exact: see _compact): what the firmware read, for
+    # undoing its corrections and emulating its learning; the fits take the plan's
+    temp_c: FloatArray = data.temp_c.astype(np.float64)
+    held: HeaterJudgement | None = None  # judged once, on the temperature fitted on
     per_kind: list[tuple[SensorFit, Recording]] = []
     raw: dict[str, FloatArray] = {}  # what the firmware's learner is fed, per kind
     intervals, changes = param_intervals(
@@ -1056,11 +1085,20 @@ def _imu(run: _Run, data: _ImuData) -> None:
         )  # fmt: skip
         sub_rec.source = str(run.log)
         sub_rec.validate()
+        sub_rec, thermo = sensor_temperature(
+            sub_rec, f"IMU.{inst}", temperature=run.plan.temperature,
+            source=run.plan.source_for(kind, inst),
+        )  # fmt: skip
+        if held is None:  # one thermometer per IMU: the same for its two sensors
+            held = _heater(run, inst, sub_rec)
         fit = fit_sensor(
             sub_rec, f"IMU.{prefix}", kind, inst, overrides=run.overrides,
             firmware="ardupilot", motions=run.motions,
         )  # fmt: skip
         fit.heater = held.to_dict()
+        said = record_thermometer(fit, thermo, f"IMU.{inst}")
+        if said and kind == "gyro":  # one thermometer per IMU: said once
+            run.params.notes.append(said)
         run.fits.append(fit)
         per_kind.append((fit, sub_rec))
         if kind == "gyro":
@@ -1069,6 +1107,7 @@ def _imu(run: _Run, data: _ImuData) -> None:
             del vals
         # the step check across instances reads the stillness result (motions), not values
         run.series[f"{fit.topic}.{inst}"] = (time_s, np.empty((0, len(AXES))))
+    assert held is not None  # KINDS is not empty
     sub = Calibration([ch for f, _r in per_kind for ch in f.channels])
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
@@ -1083,6 +1122,29 @@ def _imu(run: _Run, data: _ImuData) -> None:
     emulated = (
         _emulate(run, inst, data.ahz, time_s, temp_c, raw, ps.params) if run.emulate else None
     )
+    _reports(run, inst, per_kind, ps, held, emulated, active, fw_range)
+
+
+def _heater(run: _Run, inst: int, rec: Recording) -> HeaterJudgement:
+    """IMU ``inst``'s heater hold (:func:`.heated.judge_instance`) judged on the temperature
+    its fits take (``rec``'s: reconstructed, or borrowed), its warnings and a stall's
+    (no hold, or an inferred one) added to the run's gates."""
+    time_s, temp_c = rec.time_s, rec.temperature_c("temperature")
+    held = judge_instance(
+        f"{run.log}: IMU.{inst}", time_s, temp_c, run.flight.parameters, "ardupilot", run.heater
+    )
+    run.gates.extend(held.warnings)
+    if held.hold is None or held.hold.setpoint_source == "inferred":  # a stall, or a heater?
+        run.gates.append(stall_warning(f"IMU.{inst}", time_s, temp_c))
+    return held
+
+
+def _reports(
+    run: _Run, inst: int, per_kind: list[tuple[SensorFit, Recording]], ps: Any,
+    held: HeaterJudgement, emulated: ArdupilotEmulation | None, active: Any, fw_range: Any,
+) -> None:  # fmt: skip
+    """IMU ``inst``'s gyro and accelerometer compared with the log's coefficients and the
+    firmware's learning (``active``, ``fw_range``), and their reports requested."""
     for fit, sub_rec in per_kind:
         key = f"{fit.topic}.{inst}"
         if active is not None:  # the log's coefficients against the new ones

@@ -72,6 +72,9 @@ class SensorFit:
         The fitted channels.
     adequacy : dict
         The data's judgement.
+    thermometer : dict
+        The temperature fitted on: its thermometer (lattice step, update period), whether
+        reconstructed, and whose (:func:`.thermometers.sensor_temperature`).
     heater : dict or None
         The heater's hold (:class:`thermocal.heater.HeaterHold`), None: none found.
     """
@@ -87,6 +90,7 @@ class SensorFit:
     holdout_rms: dict[str, float] = field(default_factory=dict)
     channels: list[Channel] = field(default_factory=list)
     adequacy: dict[str, Any] = field(default_factory=dict)
+    thermometer: dict[str, Any] = field(default_factory=dict)
     heater: dict[str, Any] | None = None
     """The heater's hold found in its temperature (:meth:`thermocal.heater.HeaterHold.to_dict`),
     None: none."""

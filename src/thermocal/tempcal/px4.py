@@ -64,6 +64,14 @@ from thermocal.tempcal.pipeline import (
     summary,
     warn_gates,
 )
+from thermocal.tempcal.thermometers import (
+    TemperatureMode,
+    TempsFrom,
+    ThermometerPlan,
+    px4_plan,
+    record_thermometer,
+    sensor_temperature,
+)
 
 TOPICS = ("sensor_gyro", "sensor_accel")
 
@@ -304,6 +312,8 @@ def px4_tempcal(
     allan: bool = False,
     heater: HeaterOptions | None = None,
     emulate_learning: bool = False,
+    temperature: TemperatureMode = "reconstructed",
+    temps_from: TempsFrom | None = None,
 ) -> Px4TempcalResult:
     """PX4's thermal calibration of every sensor instance of a ULog, written as one set.
 
@@ -328,12 +338,19 @@ def px4_tempcal(
     heater : HeaterOptions, optional
         How a heater's hold is looked for (default: the set-point ``SENS_IMU_TEMP`` when
         ``SENS_EN_THERMAL`` is on, else inferred; ±0.5 °C for 60 s; a cut range said,
-        :class:`thermocal.heater.HeaterOptions`).
+        :class:`thermocal.heater.HeaterOptions`), in the temperature fitted on
+        (``temperature``, ``temps_from``).
     emulate_learning : bool, optional
         Also emulate PX4's on-board temperature calibration (``SYS_CAL_TDEL``,
         ``SYS_CAL_TMIN``, ``SYS_CAL_TMAX`` from the log, else PX4's defaults) on each gyro
         and accelerometer instance (:func:`thermocal.tempcal.learning.emulate_px4`);
         default False.
+    temperature : {"reconstructed", "raw"}, optional
+        A quantised or slow thermometer (:mod:`thermocal.thermometer`) is fitted on the
+        temperature reconstructed at each sample (default), or on its reading as logged.
+    temps_from : TempsFrom, optional
+        Calibrate against another instance's (or the first barometer's) thermometer, joined
+        by time (:func:`.thermometers.sensor_temperature`); default each its own.
 
     Returns
     -------
@@ -381,6 +398,7 @@ def px4_tempcal(
         return _px4_tempcal(
             flight, output, tref_c, overrides, reporter, pool, allan,
             heater or HeaterOptions(), {} if emulate_learning else None,
+            px4_plan(flight, temperature, temps_from),
         )  # fmt: skip
 
 
@@ -394,9 +412,11 @@ def _px4_tempcal(
     allan: bool = False,
     heater: HeaterOptions | None = None,
     emulated: dict[str, Px4Emulation] | None = None,
+    plan: ThermometerPlan | None = None,
 ) -> Px4TempcalResult:
     """:func:`px4_tempcal` after its output checks (``pool``: the report worker;
-    ``emulated``: filled with the on-board calibration emulated, when given)."""
+    ``emulated``: filled with the on-board calibration emulated, when given; ``plan``: the
+    temperature each instance is fitted on)."""
     from thermocal.export.params import ParamSet
 
     log, topics = flight.path, flight.instances
@@ -421,7 +441,7 @@ def _px4_tempcal(
                 continue
             fit, more = _imu_instance(
                 flight, name, inst, tref_c, overrides, params, out_set, (series, motions), old,
-                allan, heater or HeaterOptions(), emulated,
+                allan, heater or HeaterOptions(), emulated, plan or ThermometerPlan(),
             )  # fmt: skip
             fits.append(fit)
             gates.extend(more)
@@ -551,12 +571,14 @@ def _imu_instance(
     allan: bool = False,
     heater: HeaterOptions | None = None,
     emulated: dict[str, Px4Emulation] | None = None,
+    plan: ThermometerPlan | None = None,
 ) -> tuple[SensorFit, list[str | None]]:
     """A gyro or accelerometer instance through the pipeline: read, fit, its gates, its
     ``TC_G``/``TC_A`` parameters merged into ``params``, its report (``allan``: with its
     Allan section); ``found`` (series, motions) gets its (time [s], x/y/z in the canonical
     unit) and its stillness result for the step check across instances; ``heater``: how its
-    heater's hold is looked for (:func:`.heated.judge_instance`)."""
+    heater's hold is looked for (:func:`.heated.judge_instance`) in the temperature fitted
+    on; ``plan``: that temperature (reconstructed, or borrowed)."""
     from thermocal.export.params import export_params
     from thermocal.readers.ulog import release_parsed_topic
     from thermocal.tempcal.heated import judge_instance
@@ -567,12 +589,15 @@ def _imu_instance(
     rec = flight.recording(where)
     release_parsed_topic(log, where)  # read once: its raw messages are not needed again
     series, motions = found
+    logged = rec if emulated is not None else None  # the firmware learns on its own, as logged
+    rec, thermo = _planned_temperature(rec, where, kind, inst, plan or ThermometerPlan())
     temp_c = rec.temperature_c("temperature")
     held = judge_instance(
         f"{log}: {where}", rec.time_s, temp_c, flight.parameters, "px4", heater or HeaterOptions()
     )
     fit = fit_sensor(rec, name, kind, inst, overrides=overrides, motions=motions)
     fit.heater = held.to_dict()
+    said = record_thermometer(fit, thermo, where)
     # the step check across instances reads the stillness result (motions), not the values
     series[where] = (rec.time_s, np.empty((0, len(AXES))))
     gates: list[str | None] = [*held.warnings]
@@ -591,12 +616,13 @@ def _imu_instance(
             sub, "px4", instance=inst, device_id={kind: fit.device_id}, tref_c=tref_c
         )
     params.merge(ps, where)
+    params.notes.extend([said] if said else [])
     params.notes.extend(f"{where}: {n}" for n in held.notes if held.hold is not None)
     prev = old.compare(
         where, ps.params, kind, inst, fit.device_id, "rad/s" if kind == "gyro" else "m/s^2",
         fit.sweep_c,
     )  # fmt: skip
-    em = None if emulated is None else _emulate(flight, rec, where, kind, inst, fit, ps.params)
+    em = None if logged is None else _emulate(flight, logged, where, kind, inst, fit, ps.params)
     if em is not None and emulated is not None:
         emulated[where] = em
     shown = (*AXES, "temperature")  # what the report reads: the device id column left here
@@ -619,6 +645,7 @@ def _imu_instance(
                 "'hold-out rms' is the rms of a cubic fitted to the even bins on the odd "
                 "ones, in the canonical unit (°/h or mg).",
                 *(f"Firmware: {n}" for n in ps.notes),
+                *((f"Temperature: {said}",) if said else ()),
                 *(f"Heater: {n}" for n in held.notes),
                 *(() if allan else (NO_ALLAN,)),
             ),
@@ -628,6 +655,17 @@ def _imu_instance(
         ),
     )  # fmt: skip
     return fit, gates
+
+
+def _planned_temperature(
+    rec: Recording, where: str, kind: str, inst: int, plan: ThermometerPlan
+) -> tuple[Recording, dict[str, Any]]:
+    """Instance ``where``'s recording with the temperature it is fitted on (``plan``: its
+    own reconstructed when coarse or slow, or another's joined by time) and what was done
+    (:func:`.thermometers.sensor_temperature`)."""
+    return sensor_temperature(
+        rec, where, temperature=plan.temperature, source=plan.source_for(kind, inst)
+    )
 
 
 def _emulate(
