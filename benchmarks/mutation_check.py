@@ -3810,6 +3810,30 @@ MUTANTS: tuple[Mutant, ...] = (
         _t("metrics_streaming"),
         "the streamed bias stability with ddof 0",
     ),
+    Mutant(
+        "quantile-stirling-coefficient",
+        P + "stability/quantiles.py",
+        "1.0 / 12.0 - r * (1.0 / 360.0",
+        "1.0 / 12.0 - r * (1.0 / 361.0",
+        _t("quantiles"),
+        "Stirling's series of ln Γ(a+1) one coefficient off: the chi-square quantiles at ν ≥ 20",
+    ),
+    Mutant(
+        "quantile-fraction-prefactor",
+        P + "stability/quantiles.py",
+        "q = math.exp(log_d + math.log(a)) * _fraction(a, x)",
+        "q = math.exp(log_d + math.log(a) - math.log(x)) * _fraction(a, x)",
+        _t("quantiles"),
+        "the continued fraction's prefactor e^-x x^a / Γ(a) divided by x once more",
+    ),
+    Mutant(
+        "quantile-newton-bracket",
+        P + "stability/quantiles.py",
+        "        if (f < p) == lower:",
+        "        if (f > p) == lower:",
+        _t("quantiles"),
+        "the Newton steps' bracket kept on the wrong side of the root",
+    ),
 )
 
 

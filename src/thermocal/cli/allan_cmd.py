@@ -290,10 +290,8 @@ def allan_cmd(
     terms (quantization, angle random walk, bias instability, rate random walk, rate
     ramp) by least squares and by IEEE 952 slope lines.  Gaps are never
     differenced across: each contiguous stretch is processed alone and pooled."""
-    # imported while the file is read; the noise terms' least squares (scipy.linalg) only
-    # on the default path, not the deviation family's
-    family = deviation is not None or data_type == "phase"
-    prefetch("scipy.special", *(() if family else ("scipy.linalg",)), "rich.table")
+    # imported while the file is read (the intervals' quantiles need no scipy)
+    prefetch("rich.table")
     one = split_names(t_names) if t_names is not None else None
     if signal is None and one is not None and len(one) == 1:
         signal = one[0]  # a one-column text log (Stable32's data files): its column

@@ -31,11 +31,8 @@ from typing import Final
 import numpy as np
 import numpy.typing as npt
 
-from thermocal._lazy import LazyModule
 from thermocal.errors import ParameterError, ThermocalInputError
-
-# the chi-square quantiles from scipy.special (0.2 s to import), when first needed
-special = LazyModule("scipy.special")
+from thermocal.stability import quantiles as _quantiles
 
 FloatArray = npt.NDArray[np.float64]
 
@@ -1240,6 +1237,6 @@ def confidence_interval(
     dev = np.asarray(adev, dtype=np.float64)
     nu = np.asarray(edf, dtype=np.float64)
     p_lo = (1.0 - confidence) / 2.0
-    chi_hi = special.chdtri(nu, p_lo)  # upper quantile: inverse survival function
-    chi_lo = 2.0 * special.gammaincinv(nu / 2.0, p_lo)  # lower quantile: inverse CDF
+    chi_hi = _quantiles.chi2_isf(p_lo, nu)  # upper quantile: inverse survival function
+    chi_lo = _quantiles.chi2_ppf(p_lo, nu)  # lower quantile: inverse CDF
     return dev * np.sqrt(nu / chi_hi), dev * np.sqrt(nu / chi_lo)
