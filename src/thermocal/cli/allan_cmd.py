@@ -4,7 +4,7 @@ IEEE 952 noise terms by slope lines and by least squares."""
 import contextlib
 import math
 import warnings
-from collections.abc import Iterator, Mapping
+from collections.abc import Callable, Iterator, Mapping
 from pathlib import Path
 from typing import TYPE_CHECKING, Annotated
 
@@ -47,7 +47,6 @@ if TYPE_CHECKING:
     import thermocal.stability.api as _api
     import thermocal.stability.family as _family
     import thermocal.stability.registry as _registry
-    import thermocal.stability.total as _total
     import thermocal.writers as _writers
 else:
     _large = LazyModule("thermocal.pipeline.large")
@@ -57,7 +56,6 @@ else:
     _family = LazyModule("thermocal.stability.family")
     _registry = LazyModule("thermocal.stability.registry")
     _api = LazyModule("thermocal.stability.api")
-    _total = LazyModule("thermocal.stability.total")
 
 
 def parse_taus(text: str) -> str | list[float]:
@@ -330,7 +328,7 @@ def allan_cmd(
     _check_plot(plot, file)
     tau_spec = parse_taus(taus)
     devs = parse_deviations(deviation) if deviation is not None else None
-    with _total_bar(devs):
+    with _total_bar(devs) as on_total:
         res = _analysis.allan_analysis(
             rec, split_names(signal) or [rec.signals[0]], taus=tau_spec, confidence=confidence,
             deviations=devs, data_type=data_type, dynamic_s=dynamic, where=str(file),
@@ -338,6 +336,7 @@ def allan_cmd(
             noise_id=noise_id,
             max_work=max_work,
             overwrite=True,  # the recording read here is not used after the analysis
+            progress=on_total,
         )  # fmt: skip
     if res.is_family:
         _emit_family(file, res, as_json)
@@ -348,13 +347,20 @@ def allan_cmd(
 
 
 @contextlib.contextmanager
-def _total_bar(devs: list[str] | None) -> Iterator[None]:
-    """A progress bar (terminal only) while the total family is computed."""
+def _total_bar(devs: list[str] | None) -> Iterator[Callable[[float], None] | None]:
+    """A determinate progress bar (terminal only) while the total family is computed: yields
+    the library's callback (the fraction done), or None when no total deviation is asked."""
     if not devs or not {"mtotdev", "ttotdev", "htotdev"} & set(devs):
-        yield
+        yield None
         return
-    with progress("total deviations") as advance, _total.reporting(advance):
-        yield
+    with progress("total deviations", total=1.0) as advance:
+        shown = [0.0]
+
+        def to(frac: float) -> None:  # the bar advances by the new fraction's increment
+            advance(frac - shown[0])
+            shown[0] = frac
+
+        yield to
 
 
 def _emit_family(file: Path, res: "_analysis.AllanAnalysis", as_json: bool) -> None:
