@@ -1044,8 +1044,8 @@ MUTANTS: tuple[Mutant, ...] = (
     Mutant(
         "stability-lag1-phase-detrend",
         P + "stability/edf.py",
-        "        zc = z - z.mean()\n        r1 = _lag1_in_place(zc)",
-        "        zc = _detrend(z, 1)\n        r1 = _lag1_in_place(zc)",
+        "_lag1_differenced(_lag1_centred(z, mu), z, dmax",
+        "_lag1_differenced(_lag1_centred(_detrend(z, 1), 0.0), z, dmax",
         STAB + _t("noise_id_stable32"),
         "lag-1 identification of phase data removes a line (Stable32 removes nothing)",
     ),
