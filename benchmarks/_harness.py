@@ -1,12 +1,15 @@
 """What several benchmarks share: running ``thermocal`` (or a script) as a child process and
-reading its wall time and peak resident memory (``RUSAGE_CHILDREN`` of a wrapper process, so
-that each measurement is of one child alone)."""
+reading its wall time, CPU time and peak resident memory (``RUSAGE_CHILDREN`` of a wrapper
+process, so that each measurement is of one child alone), and the Parquet recording the
+``allan`` benchmarks read."""
 
 from __future__ import annotations
 
 import subprocess
 import sys
 from pathlib import Path
+
+import numpy as np
 
 THERMOCAL = [sys.executable, "-c", "import sys; from thermocal.cli import main; sys.exit(main())"]
 """``thermocal`` in this interpreter's environment."""
@@ -16,46 +19,34 @@ import resource, subprocess, sys, time
 t0 = time.perf_counter()
 proc = subprocess.run(sys.argv[1:], stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
 dt = time.perf_counter() - t0
-print(f"{proc.returncode} {resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss} {dt:.4f}")
+use = resource.getrusage(resource.RUSAGE_CHILDREN)
+print(f"{proc.returncode} {use.ru_maxrss} {dt:.4f} {use.ru_utime + use.ru_stime:.4f}")
 if proc.returncode:
     print(proc.stderr[-2000:], file=sys.stderr)
 """
+"""Prints the child's exit status, peak resident memory [kB], wall time [s] and CPU time
+(user + system) [s]."""
+
+
+def measure_cpu(cmd: list[str], env: dict[str, str] | None = None) -> tuple[float, float, float]:
+    """(wall seconds, peak resident MB, CPU seconds: user + system) of one child process run
+    with ``env`` (default this one's); a failure stops the benchmark."""
+    res = subprocess.run(
+        [sys.executable, "-c", WRAPPER, *cmd], capture_output=True, text=True, env=env
+    )
+    code, peak_kb, seconds, cpu = res.stdout.split()
+    if int(code) != 0:
+        raise SystemExit(f"{cmd[3:] if cmd[:1] == THERMOCAL[:1] else cmd} failed: {res.stderr}")
+    return float(seconds), int(peak_kb) / 1024.0, float(cpu)
 
 
 def measure(cmd: list[str]) -> tuple[float, float]:
     """(wall seconds, peak resident MB) of one child process; a failure stops the benchmark."""
-    res = subprocess.run([sys.executable, "-c", WRAPPER, *cmd], capture_output=True, text=True)
-    code, peak_kb, seconds = res.stdout.split()
-    if int(code) != 0:
-        raise SystemExit(f"{cmd[3:] if cmd[:1] == THERMOCAL[:1] else cmd} failed: {res.stderr}")
-    return float(seconds), int(peak_kb) / 1024.0
+    wall, mb, _cpu = measure_cpu(cmd)
+    return wall, mb
 
 
 # --- shared by the flight-controller benchmarks (bench_px4_algorithm, bench_ardupilot_algorithm)
-
-CPU_WRAPPER = r"""
-import resource, subprocess, sys, time
-t0 = time.perf_counter()
-proc = subprocess.run(sys.argv[1:], stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
-dt = time.perf_counter() - t0
-ru = resource.getrusage(resource.RUSAGE_CHILDREN)
-print(f"{proc.returncode} {ru.ru_maxrss} {dt:.4f} {ru.ru_utime + ru.ru_stime:.4f}")
-if proc.returncode:
-    print(proc.stderr[-2000:], file=sys.stderr)
-"""
-"""``WRAPPER`` with the CPU time [s] of the child and its own children added (user + system):
-on a loaded machine the wall time is mostly waiting for a core, the CPU time is what the
-program costs."""
-
-
-def measure_cpu(cmd: list[str]) -> tuple[float, float, float]:
-    """(wall [s], peak resident memory of the largest process [MB], CPU [s]) of one run."""
-    res = subprocess.run([sys.executable, "-c", CPU_WRAPPER, *cmd], capture_output=True,
-                         text=True, check=False)  # fmt: skip
-    code, peak_kb, wall, cpu = res.stdout.split()
-    if int(code) != 0:
-        raise SystemExit(f"{cmd} failed: {res.stderr}")
-    return float(wall), int(peak_kb) / 1024.0, float(cpu)
 
 
 def compiled(trees: list[Path]) -> None:
@@ -115,3 +106,33 @@ def memory_above(peak_mb: float, log: Path, tiny_peak_mb: float, tiny: Path) -> 
           "RSS of the largest process, wrapper's RUSAGE_CHILDREN; target <= 2x: "
           f"{'met' if above <= 2 * log_mb else 'NOT met'})")  # fmt: skip
     return above
+
+
+ALLAN_COLUMNS = {"rate": "rate [deg/h]", "phase": "angle [deg]"}
+"""The signal column of :func:`write_allan_parquet` per data type."""
+
+
+def write_allan_parquet(path: Path, rows: int, data_type: str = "rate") -> Path:
+    """The ``allan`` benchmarks' recording, written once (atomically) to ``path``: 100 Hz
+    time [s], the signal — a rate [deg/h] of white noise, a slow random walk and 10 deg/h,
+    or for ``data_type="phase"`` its running angle [deg] — two temperature ramps and one
+    unused column, uncompressed, seeded (the same file on every machine)."""
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    if path.exists():
+        return path
+    path.parent.mkdir(parents=True, exist_ok=True)
+    rng = np.random.default_rng(0)
+    t = np.arange(rows) * 0.01
+    y = rng.standard_normal(rows) + np.cumsum(rng.standard_normal(rows)) * 1e-4 + 10.0
+    if data_type == "phase":
+        y = np.cumsum(y * (0.01 / 3600.0))  # the angle [deg] of a rate [deg/h]
+    ramp = 1e-6 * np.arange(rows)
+    table = pa.table({"time [s]": t, ALLAN_COLUMNS[data_type]: y, "T1 [degC]": 25.0 + ramp,
+                      "T2 [degC]": 24.0 + ramp, "aux": rng.standard_normal(rows)})  # fmt: skip
+    del t, y, ramp
+    tmp = path.with_suffix(".tmp")
+    pq.write_table(table, tmp, compression="none")
+    tmp.rename(path)
+    return path

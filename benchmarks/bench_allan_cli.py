@@ -18,9 +18,11 @@ before], ours, theirs …), best of ``--repeat``:
 * before (``--before SRC``): the same command run on another tree's ``src`` (e.g. ``git
   archive BASE src | tar -x -C /tmp/old``), so that a gain is the code's, not the machine's.
 
-Every process's wall time and peak resident memory come from
-:func:`_harness.measure`'s wrapper.  Memory per row is ``bench_memory.py``'s figure,
-``(peak RSS at N rows − peak RSS of the same command at 10⁴ rows) / N``; target ≤ 40 B/row.
+Every process's wall time, CPU time (user + system: the steadier figure on a loaded
+machine) and peak resident memory come from :func:`_harness.measure_cpu`'s wrapper; each
+side's best wall and best CPU time are compared (target ≥ 3× in both).  Memory per row is
+``bench_memory.py``'s figure, ``(peak RSS at N rows − peak RSS of the same command at 10⁴
+rows) / N``; target ≤ 40 B/row.
 
 thermocal is an editable install here and the environment may set
 ``PYTHONDONTWRITEBYTECODE``: every child runs with byte-code caching on, into a cache
@@ -47,9 +49,7 @@ import sys
 import tempfile
 from pathlib import Path
 
-import numpy as np
-
-from _harness import THERMOCAL, WRAPPER
+from _harness import ALLAN_COLUMNS, THERMOCAL, measure_cpu, write_allan_parquet
 
 HERE = Path(__file__).resolve().parent
 DATA = HERE / "_data"
@@ -58,7 +58,7 @@ PY = sys.executable
 TINY = 10_000
 """Rows of the memory baseline's file."""
 
-COLUMN = {"rate": "rate [deg/h]", "phase": "angle [deg]"}
+COLUMN = ALLAN_COLUMNS
 DEVIATIONS = ["default", "oadev", "oadev/stable32", "adev", "mdev", "tdev", "hdev", "ohdev",
               "totdev", "tierms"]  # fmt: skip
 QUICK = ["default", "adev", "hdev", "totdev"]
@@ -75,27 +75,8 @@ print(len(out[0]), out[1][0])
 
 
 def write_file(rows: int, data_type: str) -> Path:
-    """The benchmark's Parquet file (written once)."""
-    import pyarrow as pa
-    import pyarrow.parquet as pq
-
-    path = DATA / f"allan_cli_{rows}_{data_type}.parquet"
-    if path.exists():
-        return path
-    DATA.mkdir(exist_ok=True)
-    rng = np.random.default_rng(0)
-    t = np.arange(rows) * 0.01
-    y = rng.standard_normal(rows) + np.cumsum(rng.standard_normal(rows)) * 1e-4 + 10.0
-    if data_type == "phase":
-        y = np.cumsum(y * (0.01 / 3600.0))  # the angle [deg] of a rate [deg/h]
-    ramp = 1e-6 * np.arange(rows)
-    table = pa.table({"time [s]": t, COLUMN[data_type]: y, "T1 [degC]": 25.0 + ramp,
-                      "T2 [degC]": 24.0 + ramp, "aux": rng.standard_normal(rows)})  # fmt: skip
-    del t, y, ramp
-    tmp = path.with_suffix(".tmp")
-    pq.write_table(table, tmp, compression="none")
-    tmp.rename(path)
-    return path
+    """The benchmark's Parquet file (written once, :func:`_harness.write_allan_parquet`)."""
+    return write_allan_parquet(DATA / f"allan_cli_{rows}_{data_type}.parquet", rows, data_type)
 
 
 def warm(path: Path) -> None:
@@ -113,14 +94,10 @@ def child_env(src: Path, cache: str) -> dict[str, str]:
     return env
 
 
-def measure(cmd: list[str], env: dict[str, str]) -> tuple[float, float]:
-    """(wall seconds, peak resident MB) of one child process (``_harness.measure`` with an
-    environment); a failure stops the benchmark."""
-    res = subprocess.run([PY, "-c", WRAPPER, *cmd], capture_output=True, text=True, env=env)
-    code, peak_kb, seconds = res.stdout.split()
-    if int(code) != 0:
-        raise SystemExit(f"{cmd[3:]} failed: {res.stderr}")
-    return float(seconds), int(peak_kb) / 1024.0
+def measure(cmd: list[str], env: dict[str, str]) -> tuple[float, float, float]:
+    """(wall seconds, peak resident MB, CPU seconds) of one child process
+    (:func:`_harness.measure_cpu`); a failure stops the benchmark."""
+    return measure_cpu(cmd, env)
 
 
 def ours(path: Path, data_type: str, dev: str) -> list[str]:
@@ -191,36 +168,43 @@ def load() -> str:
 
 def run_one(
     args: argparse.Namespace, script: Path, data_type: str, dev: str, envs: dict[str, dict]
-) -> None:
-    """One row of the table: interleaved runs, best of ``args.repeat``."""
+) -> dict[str, tuple[float, float, float]]:
+    """One row of the table: interleaved runs, best of ``args.repeat`` (wall and CPU each
+    its own best; memory the wall-best run's)."""
     path = write_file(args.rows, data_type)
     tiny = write_file(TINY, data_type)
     best: dict[str, tuple[float, float]] = {}
+    cpu: dict[str, float] = {}
     sides = ["ours", "theirs", *(["before"] if "before" in envs else [])]
     if args.memory_only:
         sides = ["ours", *(["before"] if "before" in envs else [])]
     for _ in range(args.repeat):
         for side in sides:
             if side == "theirs":
-                got = measure(theirs(script, path, data_type, dev), envs["ours"])
+                wall, mb, c = measure(theirs(script, path, data_type, dev), envs["ours"])
             else:
-                got = measure(ours(path, data_type, dev), envs[side])
-            best[side] = min(best.get(side, got), got)
+                wall, mb, c = measure(ours(path, data_type, dev), envs[side])
+            best[side] = min(best.get(side, (wall, mb)), (wall, mb))
+            cpu[side] = min(cpu.get(side, c), c)
     base = {s: measure(ours(tiny, data_type, dev), envs[s])[1] for s in sides if s != "theirs"}
     t_o, mb_o = best["ours"]
     per_row = (mb_o - base["ours"]) * 1024 * 1024 / args.rows
-    line = f"{data_type:<6s}{dev:<15s}{t_o:7.2f} s {mb_o:6.0f} MB {per_row:5.1f} B/row"
+    line = f"{data_type:<6s}{dev:<15s}{t_o:6.2f} s {cpu['ours']:5.2f} cpu {mb_o:5.0f} MB"
+    line += f" {per_row:5.1f} B/row"
     if "theirs" in best:
         t_t, mb_t = best["theirs"]
-        ratio = t_t / t_o
-        line += f" | allantools {t_t:6.2f} s {mb_t:6.0f} MB | {ratio:5.2f}x"
-        line += " met" if ratio >= 3 else " NOT met"
+        ratio, c_ratio = t_t / t_o, cpu["theirs"] / cpu["ours"]
+        line += f" | allantools {t_t:6.2f} s {cpu['theirs']:5.2f} cpu {mb_t:5.0f} MB"
+        line += f" | {ratio:5.2f}x wall {c_ratio:5.2f}x cpu"
+        line += " met" if min(ratio, c_ratio) >= 3 else " NOT met"
     if "before" in best:
         t_b, mb_b = best["before"]
         pr_b = (mb_b - base["before"]) * 1024 * 1024 / args.rows
-        line += f" | before {t_b:6.2f} s {mb_b:6.0f} MB {pr_b:5.1f} B/row ({t_b / t_o:4.2f}x)"
+        line += f" | before {t_b:6.2f} s {cpu['before']:5.2f} cpu {mb_b:5.0f} MB {pr_b:5.1f} B/row"
+        line += f" ({t_b / t_o:4.2f}x wall {cpu['before'] / cpu['ours']:4.2f}x cpu)"
     line += f" | mem {'met' if per_row <= 40 else 'NOT met'} | load {load()}"
     print(line, flush=True)
+    return {s: (*best[s], cpu[s]) for s in sides}
 
 
 def main() -> None:
@@ -261,8 +245,8 @@ def main() -> None:
             for env in envs.values():  # fill the byte-code cache
                 measure(ours(write_file(TINY, kind), kind, "default"), env)
             print(
-                f"{'input':<6s}{'deviation':<15s} thermocal (time, peak, above 10⁴ rows) | "
-                "anchor | ratio, target >= 3x | before | memory target <= 40 B/row"
+                f"{'input':<6s}{'deviation':<15s} thermocal (wall, CPU, peak, above 10⁴ rows) "
+                "| anchor | ratios, target >= 3x | before | memory target <= 40 B/row"
             )
             for dev in devs:
                 run_one(args, script, kind, dev, envs)

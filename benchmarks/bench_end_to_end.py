@@ -40,7 +40,7 @@ from pathlib import Path
 
 import numpy as np
 
-from _harness import THERMOCAL, measure
+from _harness import THERMOCAL, measure, write_allan_parquet
 
 DATA = Path(__file__).resolve().parent / "_data"
 PY = sys.executable
@@ -171,22 +171,7 @@ def startup(runs: int = 15, before: str | None = None, bytecode: bool = True) ->
 
 
 def allan_file(rows: int) -> Path:
-    import pyarrow as pa
-    import pyarrow.parquet as pq
-
-    path = DATA / f"e2e_allan_{rows}.parquet"
-    if path.exists():
-        return path
-    DATA.mkdir(exist_ok=True)
-    rng = np.random.default_rng(0)
-    t = np.arange(rows) * 0.01
-    y = rng.standard_normal(rows) + np.cumsum(rng.standard_normal(rows)) * 1e-4 + 10.0
-    ramp = 1e-6 * np.arange(rows)
-    table = pa.table({"time [s]": t, "rate [deg/h]": y, "T1 [degC]": 25.0 + ramp,
-                      "T2 [degC]": 24.0 + ramp, "aux": rng.standard_normal(rows)})  # fmt: skip
-    del t, y, ramp
-    pq.write_table(table, path, compression="none")
-    return path
+    return write_allan_parquet(DATA / f"e2e_allan_{rows}.parquet", rows)
 
 
 def warm(path: Path) -> None:

@@ -1084,8 +1084,8 @@ MUTANTS: tuple[Mutant, ...] = (
     Mutant(
         "stability-lag1-phase-detrend",
         P + "stability/edf.py",
-        "        zc = z - z.mean()\n        r1 = _lag1_in_place(zc)",
-        "        zc = _detrend(z, 1)\n        r1 = _lag1_in_place(zc)",
+        "_lag1_differenced(_lag1_centred(z, mu), z, dmax",
+        "_lag1_differenced(_lag1_centred(_detrend(z, 1), 0.0), z, dmax",
         STAB + _t("noise_id_stable32"),
         "lag-1 identification of phase data removes a line (Stable32 removes nothing)",
     ),
@@ -4124,6 +4124,30 @@ MUTANTS: tuple[Mutant, ...] = (
         "n_psd = math.sqrt(level) * si",
         _t("psd", "noise_psd"),
         "the PSD's N without the one-sided factor 2",
+    ),
+    Mutant(
+        "quantile-stirling-coefficient",
+        P + "stability/quantiles.py",
+        "1.0 / 12.0 - r * (1.0 / 360.0",
+        "1.0 / 12.0 - r * (1.0 / 361.0",
+        _t("quantiles"),
+        "Stirling's series of ln Γ(a+1) one coefficient off: the chi-square quantiles at ν ≥ 20",
+    ),
+    Mutant(
+        "quantile-fraction-prefactor",
+        P + "stability/quantiles.py",
+        "q = math.exp(log_d + math.log(a)) * _fraction(a, x)",
+        "q = math.exp(log_d + math.log(a) - math.log(x)) * _fraction(a, x)",
+        _t("quantiles"),
+        "the continued fraction's prefactor e^-x x^a / Γ(a) divided by x once more",
+    ),
+    Mutant(
+        "quantile-newton-bracket",
+        P + "stability/quantiles.py",
+        "        if (f < p) == lower:",
+        "        if (f > p) == lower:",
+        _t("quantiles"),
+        "the Newton steps' bracket kept on the wrong side of the root",
     ),
 )
 

@@ -111,3 +111,40 @@ def test_phase_input_is_not_written_over() -> None:
     keep = y.copy()
     stability(y, 1.0, ["oadev", "totdev"], "octave")
     np.testing.assert_array_equal(y, keep)
+
+
+@pytest.mark.parametrize("m", [1, 3, 8])
+def test_phase_lag1_in_cache_blocks_equals_the_centred_copy(m: int) -> None:
+    """The phase's lag-1 r1 and its differences' r1, taken block by block from a strided
+    view (no centred copy), equal Riley & Greenhall's formula written here on a centred
+    copy with numpy, and the noise identified is the same: white PM, white FM, random-walk
+    FM phase, with a large offset, longer than the whole-array threshold."""
+    rng = np.random.default_rng(7)
+    n = 3 * ed._WHOLE_PHASE * m + 12_345
+    records = {
+        "wpm": rng.standard_normal(n) * 1e-9 + 5.0,
+        "wfm": np.cumsum(rng.standard_normal(n)) + 1e6,
+        "rwfm": np.cumsum(np.cumsum(rng.standard_normal(n))),
+    }
+
+    def r1_direct(v: np.ndarray) -> float:
+        c = v - v.mean()
+        return float(c[:-1] @ c[1:] / (c @ c))
+
+    for name, x in records.items():
+        z = x[::m]
+        assert z.size > ed._WHOLE_PHASE
+        mu = float(z.mean())
+        zc = z - mu
+        assert ed._lag1_centred(z, mu) == pytest.approx(r1_direct(zc), rel=1e-13, abs=1e-15)
+        for d in (1, 2):
+            got = ed._lag1_of_difference(z, d, mu)
+            assert got == pytest.approx(r1_direct(np.diff(zc, d)), rel=1e-13, abs=1e-15), name
+        for dmax in (2, 3):
+            nid = ed.identify_noise(x, m, dmax=dmax, phase_input=True)
+            # Riley & Greenhall's rule by hand on the centred copy
+            d, r1 = 0, r1_direct(zc)
+            while r1 / (1 + r1) >= 0.25 and d < dmax:
+                d += 1
+                r1 = r1_direct(np.diff(zc, d))
+            assert (nid.alpha, nid.d) == (-round(2 * r1 / (1 + r1)) - 2 * d + 2, d), name

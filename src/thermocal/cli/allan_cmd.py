@@ -4,7 +4,7 @@ IEEE 952 noise terms by slope lines and by least squares."""
 import contextlib
 import math
 import warnings
-from collections.abc import Iterator, Mapping
+from collections.abc import Callable, Iterator, Mapping
 from pathlib import Path
 from typing import TYPE_CHECKING, Annotated
 
@@ -47,7 +47,6 @@ if TYPE_CHECKING:
     import thermocal.stability.api as _api
     import thermocal.stability.family as _family
     import thermocal.stability.registry as _registry
-    import thermocal.stability.total as _total
     import thermocal.writers as _writers
     from thermocal.recording import Recording
 else:
@@ -58,7 +57,6 @@ else:
     _family = LazyModule("thermocal.stability.family")
     _registry = LazyModule("thermocal.stability.registry")
     _api = LazyModule("thermocal.stability.api")
-    _total = LazyModule("thermocal.stability.total")
 
 
 def parse_taus(text: str) -> str | list[float]:
@@ -303,10 +301,8 @@ def allan_cmd(
     terms (quantization, angle random walk, bias instability, rate random walk, rate
     ramp) by least squares and by IEEE 952 slope lines.  Gaps are never
     differenced across: each contiguous stretch is processed alone and pooled."""
-    # imported while the file is read; the noise terms' least squares (scipy.linalg) only
-    # on the default path, not the deviation family's
-    family = deviation is not None or data_type == "phase"
-    prefetch("scipy.special", *(() if family else ("scipy.linalg",)), "rich.table")
+    # imported while the file is read (the intervals' quantiles need no scipy)
+    prefetch("rich.table")
     one = split_names(t_names) if t_names is not None else None
     if signal is None and one is not None and len(one) == 1:
         signal = one[0]  # a one-column text log (Stable32's data files): its column
@@ -351,7 +347,7 @@ def allan_cmd(
         return
     tau_spec = parse_taus(taus)
     devs = parse_deviations(deviation) if deviation is not None else None
-    with _total_bar(devs):
+    with _total_bar(devs) as on_total:
         res = _analysis.allan_analysis(
             rec, split_names(signal) or [rec.signals[0]], taus=tau_spec, confidence=confidence,
             deviations=devs, data_type=data_type, dynamic_s=dynamic, where=str(file),
@@ -359,6 +355,7 @@ def allan_cmd(
             noise_id=noise_id,
             max_work=max_work,
             overwrite=True,  # the recording read here is not used after the analysis
+            progress=on_total,
         )  # fmt: skip
     if res.is_family:
         _emit_family(file, res, as_json)
@@ -399,13 +396,20 @@ def _by_temperature(
 
 
 @contextlib.contextmanager
-def _total_bar(devs: list[str] | None) -> Iterator[None]:
-    """A progress bar (terminal only) while the total family is computed."""
+def _total_bar(devs: list[str] | None) -> Iterator[Callable[[float], None] | None]:
+    """A determinate progress bar (terminal only) while the total family is computed: yields
+    the library's callback (the fraction done), or None when no total deviation is asked."""
     if not devs or not {"mtotdev", "ttotdev", "htotdev"} & set(devs):
-        yield
+        yield None
         return
-    with progress("total deviations") as advance, _total.reporting(advance):
-        yield
+    with progress("total deviations", total=1.0) as advance:
+        shown = [0.0]
+
+        def to(frac: float) -> None:  # the bar advances by the new fraction's increment
+            advance(frac - shown[0])
+            shown[0] = frac
+
+        yield to
 
 
 def _emit_family(file: Path, res: "_analysis.AllanAnalysis", as_json: bool) -> None:

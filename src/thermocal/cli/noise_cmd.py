@@ -213,7 +213,7 @@ def noise_cmd(
     the Allan deviation at τ = 1 s) and the random walk (+½ line at τ = 3 s, or the
     least-squares fit), in continuous time; Kalibr's imu.yaml takes per sensor the largest
     axis."""
-    prefetch("scipy.special", "scipy.linalg", "rich.table")
+    prefetch("rich.table")  # the analysis needs no scipy (its quantiles are its own)
     if out_format not in ("kalibr", "json"):
         raise ThermocalInputError(f"--format {out_format!r}: use kalibr or json")
     if from_datasheet:

@@ -20,7 +20,7 @@ from __future__ import annotations
 import math
 import re
 import warnings
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any, Final
 
@@ -375,6 +375,7 @@ def allan_analysis(
     noise_id: str | None = None,
     max_work: float | None = None,
     overwrite: bool = False,
+    progress: Callable[[float], None] | None = None,
 ) -> AllanAnalysis:
     """The stability analysis of the channels ``names`` of ``rec`` (module docstring).
 
@@ -403,6 +404,10 @@ def allan_analysis(
         Accumulate the phase in the recording's own signal buffers (no memory per sample):
         ``rec``'s values are changed.  Only for a recording nothing reads afterwards (the
         ``allan`` command's, read from a file); default False leaves ``rec`` as it was.
+    progress : callable, optional
+        With ``deviations`` or phase data: called with the fraction done (0 to 1, rising)
+        of the total family's sums over every channel
+        (:func:`thermocal.stability.family.stability`), 1.0 at the end.
 
     Returns
     -------
@@ -433,7 +438,7 @@ def allan_analysis(
             tuple(names),
             family=_family(
                 rec, names, taus, confidence, deviations, data_type, bias_correct, noise_type,
-                noise_id or "thermocal", max_work, where, overwrite,
+                noise_id or "thermocal", max_work, where, overwrite, progress,
             ),
         )  # fmt: skip
     _refuse_family_only(bias_correct, noise_type, noise_id)
@@ -488,6 +493,7 @@ def _family(
     max_work: float | None = None,
     where: str = "",
     overwrite: bool = False,
+    progress: Callable[[float], None] | None = None,
 ) -> dict[str, StabilityResult]:
     """The deviations of every channel (phase data: the column as given, in its own unit;
     ``overwrite``: centred in the recording's own buffer when the channel is named once)."""
@@ -498,7 +504,7 @@ def _family(
     n_phase = _longest(rec) + (1 if data_type == "rate" else 0)
     check_tau_list(taus, rec.sample_interval_s, n_phase, devs, where)
     results = {}
-    for name in names:
+    for k, name in enumerate(names):
         if data_type == "phase":  # the column as given, in its own unit
             values, unit = rec.column(name), column_unit(name)
             if not unit:
@@ -518,9 +524,15 @@ def _family(
             alpha=alpha, noise_id=noise_id,
             where=where, max_work=family.DEFAULT_MAX_WORK if max_work is None else max_work,
             overwrite=overwrite and names.count(name) == 1,
+            progress=None if progress is None else _share(progress, k, len(names)),
         )  # fmt: skip
     _idle_options(results, devs, bias_correct, alpha, where)
     return results
+
+
+def _share(progress: Callable[[float], None], k: int, count: int) -> Callable[[float], None]:
+    """The ``k``-th of ``count`` channels' fractions as fractions of the whole run."""
+    return lambda frac: progress((k + frac) / count)
 
 
 BIAS_CORRECTED: Final = ("totdev", "htotdev")

@@ -25,8 +25,10 @@ The EDFs of gap-separated stretches add (independent estimates).
 
 from __future__ import annotations
 
+import contextlib
 import math
-from collections.abc import Sequence
+import threading
+from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass, field, replace
 from typing import Any, Final
 
@@ -38,6 +40,7 @@ from thermocal.errors import MissingValueError, ParameterError, ThermocalInputEr
 from thermocal.stability import deviations as dv
 from thermocal.stability import edf as ed
 from thermocal.stability import registry
+from thermocal.stability import total as _total
 
 FloatArray = npt.NDArray[np.float64]
 IntArray = npt.NDArray[np.int64]
@@ -838,6 +841,7 @@ def stability(
     max_work: float = DEFAULT_MAX_WORK,
     where: str = "",
     overwrite: bool = False,
+    progress: Callable[[float], None] | None = None,
 ) -> StabilityResult:
     r"""Several deviations of one record of rate or phase data, with chi-square intervals.
 
@@ -869,6 +873,8 @@ def stability(
         the refusals name.
     overwrite : bool
         Phase data may be centred in ``values``' own buffer (destroyed; rate: never).
+    progress : callable, optional
+        Called with the rising fraction (0–1) of the total family's sums done; 1.0 at the end.
 
     Returns
     -------
@@ -911,16 +917,73 @@ def stability(
         check_work(names, sets, record.sizes, max_work, taus, where)
         m_common = sets[""]
         record.set_octave(m_common)
-        id_cache: dict[tuple[int, int, ed.IdRules], ed.NoiseId] = {}
-        curves = {
-            n: _curve(n, sets[n], record, alpha, id_cache, noise_id, confidence, bias_correct, unit)
-            for n in names
-        }
+        with _reporting(progress, names, sets, record.sizes):
+            curves = _curves(names, sets, record, alpha, noise_id, confidence, bias_correct, unit)
         return StabilityResult(
             curves, np.asarray(m_common * float(tau0_s), dtype=np.float64), m_common,
             float(tau0_s), data_type, float(confidence), len(record.kept),
             int(sum(record.sizes)), unit, noise_id=noise_id,
         )  # fmt: skip
+
+
+_TOTAL_SUMS: Final = ("mtotdev", "ttotdev", "htotdev")
+"""The deviations whose sums :mod:`.total` computes and reports as it goes."""
+
+
+def _curves(
+    names: list[str],
+    sets: dict[str, IntArray],
+    record: _Record,
+    alpha: int | None,
+    noise_id: str,
+    confidence: float,
+    bias_correct: bool,
+    unit: str,
+) -> dict[str, DeviationCurve]:
+    """Every deviation's curve, the noise identified once per (m, order, rules)."""
+    id_cache: dict[tuple[int, int, ed.IdRules], ed.NoiseId] = {}
+    return {
+        n: _curve(n, sets[n], record, alpha, id_cache, noise_id, confidence, bias_correct, unit)
+        for n in names
+    }
+
+
+@contextlib.contextmanager
+def _reporting(
+    progress: Callable[[float], None] | None,
+    names: list[str],
+    sets: dict[str, IntArray],
+    sizes: list[int],
+) -> Iterator[None]:
+    """:func:`.total.reporting` turned into rising fractions of the total family's estimated
+    operations (those :func:`.total.tot_sums` reports: htotdev's m = 1 is ohdev's); 1.0
+    when the block ends."""
+    whole = 0.0
+    for n in names:
+        if n in _TOTAL_SUMS:
+            m = sets[n][sets[n] > 1] if n == "htotdev" else sets[n]
+            whole += sum(dv.work(n, size, m) for size in sizes)
+    if progress is None:
+        yield
+        return
+    if not whole > 0:
+        yield
+        progress(1.0)
+        return
+    lock = threading.Lock()
+    state = [0.0, 0.0]  # operations done, fraction shown
+
+    def add(ops: float) -> None:  # from the worker threads
+        with lock:
+            state[0] += ops
+            frac = min(state[0] / whole, 1.0)
+            if frac > state[1]:
+                state[1] = frac
+                progress(frac)
+
+    with _total.reporting(add):
+        yield
+    progress(1.0)
 
 
 def _unit(name: str, unit: str, data_type: str) -> str:

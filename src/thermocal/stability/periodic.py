@@ -1,7 +1,7 @@
 """Periodic terms of a static record: sinusoids found in its spectrum, named with their
 frequency where the Allan deviation shows them.
 
-Pure maths (numpy; scipy.special imported when first needed; no file I/O).
+Pure maths (numpy only; no file I/O).
 
 A sinusoid ``A·sin(2π f₀ t)`` in rate data has the Allan deviation (IEEE Std 952-1997
 Annex C.1.7)::
@@ -22,17 +22,12 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any, Final
+from typing import Any, Final
 
 import numpy as np
 import numpy.typing as npt
 
-from thermocal._lazy import LazyModule
-
-if TYPE_CHECKING:
-    import scipy.special as _special
-else:
-    _special = LazyModule("scipy.special")
+from thermocal.stability.quantiles import chi2_isf
 
 SINE_PEAK_TAU: Final = 0.3710
 """τ·f₀ at which a sinusoid's Allan deviation A·sin²(πf₀τ)/(πf₀τ) is largest."""
@@ -275,7 +270,10 @@ def periodic_terms(
     0.5 Hz, 5 deg/h
     """
     x = np.asarray(values, dtype=np.float64).ravel()[:_MAX_SAMPLES]
-    x = x[np.isfinite(x)]
+    finite = np.isfinite(x)
+    if not finite.all():  # else the record's own buffer is read (no 67 MB copy)
+        x = x[finite]
+    del finite
     if x.size < 256 * _MIN_SEGMENTS:
         return ()
     fs = 1.0 / tau0_s
@@ -290,7 +288,7 @@ def periodic_terms(
     n_bins = int(usable.sum())
     if n_bins < 8:
         return ()
-    thresh = float(_special.chdtri(dof, PERIODIC_FALSE_ALARM / n_bins)) / dof
+    thresh = float(chi2_isf(PERIODIC_FALSE_ALARM / n_bins, dof)) / dof
     thresh = max(thresh, PERIODIC_MIN_RATIO)
     ratio = np.where(usable & (floor > 0), s / np.where(floor > 0, floor, 1.0), 0.0)
     found: list[PeriodicTerm] = []
