@@ -29,7 +29,7 @@ from typing import Any, Literal
 import numpy as np
 import numpy.typing as npt
 
-from thermocal.errors import ParameterError, ThermocalInputError, ThermocalWarning
+from thermocal.errors import ParameterError, ThermocalInputError, ThermocalWarning, UnitError
 from thermocal.recording import FloatArray, Recording
 
 MIN_STEP_C = 0.1
@@ -669,7 +669,10 @@ def reconstruct_columns(
     said = []
     for name in names:
         own = np.asarray(rec.column(name), dtype=np.float64)
-        in_c = np.asarray(rec.temperature_c(name), dtype=np.float64)
+        try:
+            in_c = np.asarray(rec.temperature_c(name), dtype=np.float64)
+        except UnitError:  # raw counts without a conversion: a model in counts, left as given
+            continue
         ok = np.isfinite(in_c) & np.isfinite(own)
         if np.unique(in_c[ok]).size < 2:
             continue  # constant or empty: the data's judgement refuses it
@@ -684,7 +687,7 @@ def reconstruct_columns(
         new[name] = (made.temp_c - icpt) / slope
     if not new:
         return rec, said
-    return rec.with_columns(new, {n: rec.units.get(n, "degC") for n in new}), said
+    return rec.with_columns(new, {n: rec.units[n] for n in new}), said  # each one's own unit
 
 
 __all__ = [
