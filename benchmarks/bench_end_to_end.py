@@ -94,7 +94,7 @@ def run(cmd: list[str]) -> tuple[float, float]:
 STARTUP_COMMANDS: dict[str, tuple[list[str], tuple[int, ...]]] = {
     "--version": ([*THERMOCAL, "--version"], (0,)),
     "-m --version": ([PY, "-m", "thermocal", "--version"], (0,)),
-    "(no arguments)": ([*THERMOCAL], (2,)),
+    "(no arguments)": ([*THERMOCAL], (0,)),  # its help, as --help
     "--help": ([*THERMOCAL, "--help"], (0,)),
     "fit --help": ([*THERMOCAL, "fit", "--help"], (0,)),
 }
