@@ -273,6 +273,11 @@ def _longest_run(
     return max(runs, key=lambda r: time_s[r[1]] - time_s[r[0]])
 
 
+HOLD_MAX_SAMPLES = 1_000_000
+"""Samples a hold is looked for in: a longer record is searched on every k-th sample (k the
+smallest that keeps at most this many; the hold's times then to k sample intervals), at a
+bounded cost (the search holds about 26 B per sample searched)."""
+
 MAX_WINDOWS = 100_000
 """Most band-wide temperature windows searched for a plateau (10 000 °C at 0.1 °C): a
 temperature spanning more is a damaged record, and no set-point is inferred from it."""
@@ -404,6 +409,8 @@ def find_heater_hold(
     ok = np.isfinite(time_s) & np.isfinite(temp_c)  # a reading lost: the others still tell
     if not ok.all():
         time_s, temp_c = time_s[ok], temp_c[ok]
+    stride = -(-temp_c.size // HOLD_MAX_SAMPLES)  # a long record: every stride-th sample
+    time_s, temp_c = time_s[::stride], temp_c[::stride]
     if temp_c.size < 2:
         return None
     if setpoint_c is None:

@@ -265,6 +265,13 @@ def update_period(
     return p
 
 
+DESCRIBE_MAX_SAMPLES = 1_000_000
+"""Samples a thermometer is judged on: a longer record is judged on every k-th sample
+(k the smallest that keeps at most this many), which keeps every level a thermometer holds
+for k samples or more and its update period (to k sample intervals), at a bounded cost
+(the judgement sorts its samples: 58 B per sample judged)."""
+
+
 def describe_thermometer(time_s: FloatArray, temp_c: FloatArray) -> Thermometer:
     """Recognise a quantised or slow thermometer.
 
@@ -301,17 +308,20 @@ def describe_thermometer(time_s: FloatArray, temp_c: FloatArray) -> Thermometer:
     v = np.asarray(temp_c, dtype=np.float64)
     if t.shape != v.shape:
         raise ParameterError("temp_c", f"{{name}} has {v.size} samples, the times {t.size}")
-    ok = np.isfinite(v) & np.isfinite(t)
-    if not ok.any():
+    n_finite = int(np.count_nonzero(np.isfinite(v) & np.isfinite(t)))
+    if n_finite == 0:
         raise ParameterError("temp_c", "{name} has no finite value")
+    stride = -(-t.size // DESCRIBE_MAX_SAMPLES)  # a long record: every stride-th sample
+    t, v = t[::stride], v[::stride]
+    ok = np.isfinite(v) & np.isfinite(t)
     t, v = t[ok], v[ok]
     found = _levels(v)
     n_levels = int(found[0].size) if found is not None else int(np.unique(v).size)
     step = lattice_step(v)
     period = update_period(t, v, step)
-    dt = float(np.median(np.diff(t))) if t.size > 1 else 0.0
+    dt = float(np.median(np.diff(t))) / stride if t.size > 1 else 0.0
     return Thermometer(
-        n_samples=int(v.size),
+        n_samples=n_finite,
         n_levels=n_levels,
         step_c=step,
         update_period_s=period,
@@ -674,7 +684,9 @@ def reconstruct_columns(
         except UnitError:  # raw counts without a conversion: a model in counts, left as given
             continue
         ok = np.isfinite(in_c) & np.isfinite(own)
-        if np.unique(in_c[ok]).size < 2:
+        if not ok.any() or not float(np.min(in_c, where=ok, initial=np.inf)) < float(
+            np.max(in_c, where=ok, initial=-np.inf)
+        ):
             continue  # constant or empty: the data's judgement refuses it
         made = reconstruct_temperature(rec.time_s, in_c, mode=mode)
         said.append({"file": rec.name, "column": name, **made.to_dict()})
