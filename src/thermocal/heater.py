@@ -273,7 +273,7 @@ def _longest_run(
     return max(runs, key=lambda r: time_s[r[1]] - time_s[r[0]])
 
 
-HOLD_MAX_SAMPLES = 1_000_000
+HOLD_MAX_SAMPLES = 250_000
 """Samples a hold is looked for in: a longer record is searched on every k-th sample (k the
 smallest that keeps at most this many; the hold's times then to k sample intervals), at a
 bounded cost (the search holds about 26 B per sample searched)."""

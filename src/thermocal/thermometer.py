@@ -265,7 +265,7 @@ def update_period(
     return p
 
 
-DESCRIBE_MAX_SAMPLES = 1_000_000
+DESCRIBE_MAX_SAMPLES = 250_000
 """Samples a thermometer is judged on: a longer record is judged on every k-th sample
 (k the smallest that keeps at most this many), which keeps every level a thermometer holds
 for k samples or more and its update period (to k sample intervals), at a bounded cost
