@@ -30,8 +30,10 @@ def test_learning_tutorial_prints_what_the_page_shows(
     assert len(pairs) == 2
     for printed, shown in pairs:
         assert _numbers(printed) == _numbers(shown)
-        lines = [ln.rstrip() for ln in printed.strip().splitlines()]
-        assert lines == [ln.rstrip() for ln in shown.strip().splitlines()]
+        # stripped both sides: rich versions pad a table's title differently (centred with
+        # leading spaces on the floor's rich, flush on the lock's)
+        lines = [ln.strip() for ln in printed.strip().splitlines()]
+        assert lines == [ln.strip() for ln in shown.strip().splitlines()]
 
 
 def test_learning_tutorial_claims(page: tuple[list[tuple[str, str]], Path]) -> None:
