@@ -183,7 +183,11 @@ def lattice_step(values: FloatArray) -> float | None:
     """
     v = np.asarray(values, dtype=np.float64)
     v = v[np.isfinite(v)]
-    found = _levels(v)
+    return _lattice_of(v, _levels(v))
+
+
+def _lattice_of(v: FloatArray, found: tuple[FloatArray, FloatArray] | None) -> float | None:
+    """:func:`lattice_step` of the finite values ``v`` whose levels are ``found``."""
     if found is None or found[0].size < 2:
         return None
     levels, weight = found
@@ -317,7 +321,7 @@ def describe_thermometer(time_s: FloatArray, temp_c: FloatArray) -> Thermometer:
     t, v = t[ok], v[ok]
     found = _levels(v)
     n_levels = int(found[0].size) if found is not None else int(np.unique(v).size)
-    step = lattice_step(v)
+    step = _lattice_of(v, found)  # v finite: its levels are found once
     period = update_period(t, v, step)
     dt = float(np.median(np.diff(t))) / stride if t.size > 1 else 0.0
     return Thermometer(
