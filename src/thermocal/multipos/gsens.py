@@ -130,12 +130,9 @@ def _noise_var(
     n_samples: FloatArray, rate_sigma_rad_s: FloatArray, up: FloatArray, latitude_deg: float | None
 ) -> FloatArray:
     """Each pose's variance per axis [rad²/s²]: white noise and the horizontal earth rate."""
-    om = units.EARTH_RATE_RAD_S
-    if latitude_deg is None:
-        earth = np.full(up.shape, om**2 / 3.0)
-    else:
-        cl = math.cos(math.radians(latitude_deg))
-        earth = (om * cl) ** 2 * (1.0 - up**2) / 2.0
+    from thermocal.multipos.gyro import unmeasured_earth_rate_var
+
+    earth = unmeasured_earth_rate_var(up, latitude_deg)
     out: FloatArray = rate_sigma_rad_s[None, :] ** 2 / n_samples[:, None] + earth
     return out
 

@@ -387,13 +387,41 @@ def static_bias(
     om = units.EARTH_RATE_RAD_S
     b = (w[:, None] * rate_means_rad_s).sum(axis=0)
     if latitude_deg is not None:
-        sl, cl = math.sin(math.radians(latitude_deg)), math.cos(math.radians(latitude_deg))
+        sl = math.sin(math.radians(latitude_deg))
         b = b - om * sl * (w[:, None] * up).sum(axis=0)
-        var_e = (w[:, None] ** 2 * (om * cl) ** 2 * (1.0 - up**2) / 2.0).sum(axis=0)
-    else:
-        var_e = np.full(3, float((w**2).sum()) * om**2 / 3.0)
+    var_e = (w[:, None] ** 2 * unmeasured_earth_rate_var(up, latitude_deg)).sum(axis=0)
     var = rate_sigma_rad_s**2 / n_samples.sum() + var_e
     return b, np.diag(var)
+
+
+def unmeasured_earth_rate_var(up: FloatArray, latitude_deg: float | None) -> FloatArray:
+    r"""The variance the earth rate leaves in each static pose's mean rate, per axis
+    [rad²/s²], when the pose's heading is not measured (module docstring).
+
+    Parameters
+    ----------
+    up : numpy.ndarray, shape (m, 3)
+        Unit up direction of each pose in body axes.
+    latitude_deg : float or None
+        Latitude [°]: the vertical earth rate is known (and taken off by the caller), the
+        horizontal one of unknown heading counted; None: the whole earth rate, of unknown
+        direction.
+
+    Returns
+    -------
+    numpy.ndarray, shape (m, 3)
+
+    Notes
+    -----
+    .. math:: (\Omega \cos L)^2 (1 - u_{ki}^2) / 2 \quad \text{or, without } L, \quad
+              \Omega^2 / 3
+    """
+    om = units.EARTH_RATE_RAD_S
+    if latitude_deg is None:
+        return np.full(np.shape(up), om**2 / 3.0)
+    cl = math.cos(math.radians(latitude_deg))
+    out: FloatArray = (om * cl) ** 2 * (1.0 - up**2) / 2.0
+    return out
 
 
 @dataclass(frozen=True)
