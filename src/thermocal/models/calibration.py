@@ -5,12 +5,22 @@ channel (any family), with the channel's signal column, its unit as given and an
 role, in one versioned file::
 
     {
-      "format": "thermocal-calibration", "format_version": 1,
+      "format": "thermocal-calibration", "format_version": 1 | 2 | 3,
       "created_utc": "...", "thermocal_version": "...",
       "channels": [
         {"name": "gx", "signal": "gx", "unit": "deg/s",
          "role": {"kind": "gyro", "axis": "x"} | null,
          "model": { …a complete model file, with its own checksum… }},
+        …
+      ],
+      "triads": [   (only when there are triads: multipos, turntable)
+        {"name": "gyro", "columns": ["gx", "gy", "gz"], "unit": "deg/s",
+         "temperature": "temp", "encoders": [...], "latitude_deg": 45.0,
+         "model": { …TriadThermal: bias, scale factors, misalignments in T… },
+         "count_scale": {"value": K, "unit": "deg/s"},          (raw counts; version ≥ 2)
+         "g_sensitivity": [[A_xx, A_xy, A_xz], …],  (gyro only, version 3: row the gyro
+         "g_sensitivity_sigma": [[…], …],             axis, column the specific force's
+         "g_sensitivity_unit": "deg/s/g"},            axis; the triad's unit per g)
         …
       ],
       "checksum": "<sha256 of the canonical JSON without this key>"
@@ -37,14 +47,17 @@ from thermocal.models.base import TemperatureModel
 from thermocal.models.format import checksum, model_file_dict
 from thermocal.models.registry import model_from_dict
 from thermocal.models.schema import verify_model_dict
+from thermocal.recording import FloatArray
 
 CALIBRATION_FORMAT = "thermocal-calibration"
-CALIBRATION_FORMAT_VERSION = 2
-"""The newest version this thermocal reads.  Version 2 added a triad's ``count_scale``;
-a file is written as version 1 unless one of its triads has one, so a file
-without it is what it was, and a thermocal that knows only version 1 refuses a file whose
-counts it could not convert rather than apply it to the wrong unit."""
+CALIBRATION_FORMAT_VERSION = 3
+"""The newest version this thermocal reads.  Version 2 added a triad's ``count_scale``,
+version 3 a gyro triad's ``g_sensitivity``; a file is written with the lowest version
+that holds what it carries (1 without either), so a file without them is what it was, and
+an older thermocal refuses a file whose counts it could not convert, or whose
+g-sensitivity it would silently leave out, rather than apply it wrongly."""
 COUNT_SCALE_FORMAT_VERSION = 2
+G_SENSITIVITY_FORMAT_VERSION = 3
 
 ROLE_KINDS = ("gyro", "accel")
 """Roles a channel may declare."""
@@ -144,7 +157,10 @@ class Triad:
 
     Notes
     -----
-    .. math:: x_c = (I + E(T))^{-1} (x - b(T))
+    .. math:: x_c = (I + E(T))^{-1} (x - b(T) - A f)
+
+    with ``A f`` only for a gyro triad with a ``g_sensitivity`` (``f`` the accelerometer
+    triad's compensated output in g).
 
     References
     ----------
@@ -172,6 +188,21 @@ class Triad:
     physical unit the parameters and the compensated columns are in.  Compensation converts
     raw-count columns first, ``x [unit] = count_scale · N``; None: the triad was calibrated on
     data in ``unit`` (files of format version 1 have no such key)."""
+    g_sensitivity: FloatArray | None = None
+    """A gyro triad's sensitivity to specific force, the 3×3 matrix ``A`` [``unit`` per g,
+    g = 9.80665 m/s²] (row i the gyro axis, column j the specific force's axis; IEEE Std
+    952-1997 annex B, IEEE Std 1431-2004): the gyro reads ``b + A f`` more at rest under the
+    specific force ``f`` [g].  Compensation takes it off with the accelerometer triad's
+    compensated output, ``x_c = (I + E(T))⁻¹ (x − b(T) − A f)``; None: not applied (files
+    before format version 3 have no such key)."""
+    g_sensitivity_sigma: FloatArray | None = None
+    """The standard uncertainties of ``g_sensitivity`` (3×3) [``unit`` per g]."""
+
+    @property
+    def g_sensitivity_unit(self) -> str:
+        """The unit of ``g_sensitivity`` as the file states it: the triad's unit per g
+        (``deg/s/g``)."""
+        return f"{self.unit}/g"
 
     def calibrated_unit(self) -> str:
         """The unit of the columns the triad was calibrated on: raw counts for a triad with
@@ -361,11 +392,7 @@ class Calibration:
 
         d: dict[str, Any] = {
             "format": CALIBRATION_FORMAT,
-            "format_version": (
-                COUNT_SCALE_FORMAT_VERSION
-                if any(t.count_scale is not None for t in self.triads)
-                else 1
-            ),
+            "format_version": _format_version(self.triads),
             "created_utc": _dt.datetime.now(_dt.UTC).isoformat(timespec="seconds"),
             "thermocal_version": __version__,
             "channels": [
@@ -396,11 +423,35 @@ class Calibration:
                         if t.count_scale is not None
                         else {}
                     ),
+                    **_g_sensitivity_dict(t),
                 }
                 for t in self.triads
             ]
         d["checksum"] = checksum(d)
         return d
+
+
+def _format_version(triads: list[Triad]) -> int:
+    """The lowest format version that holds what the triads carry."""
+    if any(t.g_sensitivity is not None for t in triads):
+        return G_SENSITIVITY_FORMAT_VERSION
+    if any(t.count_scale is not None for t in triads):
+        return COUNT_SCALE_FORMAT_VERSION
+    return 1
+
+
+def _g_sensitivity_dict(t: Triad) -> dict[str, Any]:
+    """A triad's g-sensitivity keys in the file (none without one)."""
+    if t.g_sensitivity is None:
+        return {}
+    sigma = t.g_sensitivity_sigma
+    return {
+        "g_sensitivity": np.asarray(t.g_sensitivity, dtype=np.float64).tolist(),
+        "g_sensitivity_sigma": (
+            None if sigma is None else np.asarray(sigma, dtype=np.float64).tolist()
+        ),
+        "g_sensitivity_unit": t.g_sensitivity_unit,
+    }
 
 
 def is_calibration(d: Any) -> bool:
@@ -482,6 +533,13 @@ def calibration_from_dict(d: dict[str, Any], where: str) -> Calibration:
             f"{where}: triad {scaled!r} has a count_scale, which needs format_version "
             f"{COUNT_SCALE_FORMAT_VERSION}; the file says {ver}"
         )
+    sensed = next((t.name for t in triads if t.g_sensitivity is not None), None)
+    if sensed is not None and ver < G_SENSITIVITY_FORMAT_VERSION:
+        # an older thermocal would leave the g-sensitivity out without a word
+        raise ModelFileError(
+            f"{where}: triad {sensed!r} has a g_sensitivity, which needs format_version "
+            f"{G_SENSITIVITY_FORMAT_VERSION}; the file says {ver}"
+        )
     try:
         return Calibration(channels, triads)
     except ThermocalInputError as exc:
@@ -527,7 +585,53 @@ def _triad_from_dict(t: Any, at: str) -> Triad:
             if isinstance(x, dict)
         ),
         _count_scale_from_dict(t.get("count_scale"), t["unit"], at),
+        *_g_sensitivity_from_dict(t, model.kind, at),
     )
+
+
+def _matrix3(v: Any, at: str, what: str, nonnegative: bool) -> FloatArray:
+    """A 3×3 nested list of finite numbers (non-negative ones for a σ) as an array."""
+    ok = (
+        isinstance(v, list)
+        and len(v) == 3
+        and all(isinstance(r, list) and len(r) == 3 for r in v)
+        and all(
+            not isinstance(x, bool) and isinstance(x, int | float) and math.isfinite(x)
+            for r in v
+            for x in r
+        )
+    )
+    if not ok or (nonnegative and any(x < 0 for r in v for x in r)):
+        sign = "non-negative " if nonnegative else ""
+        raise ModelFileError(
+            f"{at}.{what}: expected a 3×3 nested list of finite {sign}numbers (rows the gyro "
+            "axes x, y, z; columns the specific force's axes)"
+        )
+    return np.array(v, dtype=np.float64)
+
+
+def _g_sensitivity_from_dict(
+    t: dict[str, Any], kind: str, at: str
+) -> tuple[FloatArray | None, FloatArray | None]:
+    """A triad's ``g_sensitivity`` and its σ (format version 3): only on a gyro triad, 3×3,
+    in the triad's unit per g as ``g_sensitivity_unit`` states; (None, None) when absent."""
+    if t.get("g_sensitivity") is None:
+        for key in ("g_sensitivity_sigma", "g_sensitivity_unit"):
+            if t.get(key) is not None:
+                raise ModelFileError(f"{at}: {key} without g_sensitivity")
+        return None, None
+    if kind != "gyro":
+        raise ModelFileError(f"{at}: a g_sensitivity belongs to a gyro triad, not a {kind}")
+    want = f"{t['unit']}/g"
+    if t.get("g_sensitivity_unit") != want:
+        raise ModelFileError(
+            f"{at}.g_sensitivity_unit: expected {want!r} (the triad's unit per g), "
+            f"got {t.get('g_sensitivity_unit')!r}"
+        )
+    a = _matrix3(t["g_sensitivity"], at, "g_sensitivity", False)
+    raw_sigma = t.get("g_sensitivity_sigma")
+    sigma = None if raw_sigma is None else _matrix3(raw_sigma, at, "g_sensitivity_sigma", True)
+    return a, sigma
 
 
 def _count_scale_from_dict(cs: Any, unit: str, at: str) -> float | None:
@@ -554,6 +658,7 @@ def _count_scale_from_dict(cs: Any, unit: str, at: str) -> float | None:
 __all__ = [
     "CALIBRATION_FORMAT",
     "CALIBRATION_FORMAT_VERSION",
+    "G_SENSITIVITY_FORMAT_VERSION",
     "Calibration",
     "Channel",
     "calibration_from_dict",
