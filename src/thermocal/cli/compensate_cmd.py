@@ -74,6 +74,15 @@ def compensate_cmd(
     chunk_rows: Annotated[
         int, typer.Option("--chunk-rows", help="Rows read and written at a time.")
     ] = defaults.DEFAULT_CHUNK_ROWS,
+    g_sensitivity: Annotated[
+        str,
+        typer.Option(
+            "--g-sensitivity",
+            help="apply: a calibration's gyro g-sensitivity is taken off with the "
+            "accelerometer triad's specific force (the recording needs its columns); off: "
+            "not, and a triad none of whose columns are in FILE is left out.",
+        ),
+    ] = "apply",
     topic: TopicOpt = None,
     stamp: StampOpt = "header",
     t_names: NamesOpt = None,
@@ -94,6 +103,7 @@ def compensate_cmd(
             model_file, file, output, read, signals=tuple(split_names(signal) or ()) or None,
             chunk_rows=chunk_rows,
             extrapolate=extrapolate, known_input=known_input, on_progress=advance,
+            g_sensitivity=g_sensitivity,
         )  # fmt: skip
     show = {"triads": _show_triads, "single": _show_single, "channels": _show_channels}
     emit(run.to_dict(), as_json, lambda: show[run.kind](run, file))
@@ -106,7 +116,8 @@ def _show_triads(run: "_compensate.CalibrationCompensation", _file: Path) -> Non
             if d.count_scale is not None
             else ""
         )
-        stdout.print(f"{d.triad}: {', '.join(d.comp_columns)} [{d.unit}]{scale}")
+        gs = " (g-sensitivity A·f taken off)" if d.g_sensitivity else ""
+        stdout.print(f"{d.triad}: {', '.join(d.comp_columns)} [{d.unit}]{scale}{gs}")
     stdout.print(f"written: {run.output}")
 
 

@@ -170,6 +170,16 @@ GyroModelOpt = Annotated[
     ),
 ]
 
+GSensitivityOpt = Annotated[
+    str,
+    typer.Option(
+        "--g-sensitivity",
+        help="The gyro's g-sensitivity (3×3, its unit per g) in the calibration, applied by "
+        "compensate: auto (when an element is beyond 3σ), apply (whenever the poses "
+        "separate it), off (reported only).",
+    ),
+]
+
 
 @app.command("multipos")
 @handle_errors
@@ -194,6 +204,7 @@ def multipos_cmd(
     accel_offset: AccelOffsetOpt = None,
     gyro_offset: GyroOffsetOpt = None,
     gyro_model: GyroModelOpt = "full",
+    g_sensitivity: GSensitivityOpt = "auto",
     time: TimeOpt = None,
     time_unit: TimeUnitOpt = None,
     accel_scale: AccelScaleOpt = None,
@@ -216,6 +227,7 @@ def multipos_cmd(
         _count_scale(accel_scale, "accel"), _count_scale(gyro_scale, "gyro"),
         window_s, still_threshold, motion_fraction, drift_deg, accel_offset, gyro_offset,
         gyro_model,
+        g_sensitivity=g_sensitivity,
         read=read_options(
             names=t_names, rate=t_rate, on_bad_lines=t_bad, delimiter=t_delim, decimal=t_dec
         ),

@@ -188,14 +188,14 @@ class Triad:
     physical unit the parameters and the compensated columns are in.  Compensation converts
     raw-count columns first, ``x [unit] = count_scale · N``; None: the triad was calibrated on
     data in ``unit`` (files of format version 1 have no such key)."""
-    g_sensitivity: FloatArray | None = None
+    g_sensitivity: FloatArray | None = field(default=None, compare=False)
     """A gyro triad's sensitivity to specific force, the 3×3 matrix ``A`` [``unit`` per g,
     g = 9.80665 m/s²] (row i the gyro axis, column j the specific force's axis; IEEE Std
     952-1997 annex B, IEEE Std 1431-2004): the gyro reads ``b + A f`` more at rest under the
     specific force ``f`` [g].  Compensation takes it off with the accelerometer triad's
     compensated output, ``x_c = (I + E(T))⁻¹ (x − b(T) − A f)``; None: not applied (files
     before format version 3 have no such key)."""
-    g_sensitivity_sigma: FloatArray | None = None
+    g_sensitivity_sigma: FloatArray | None = field(default=None, compare=False)
     """The standard uncertainties of ``g_sensitivity`` (3×3) [``unit`` per g]."""
 
     @property

@@ -34,6 +34,7 @@ motions carry it as a misfit (their reduced χ²).
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -238,6 +239,66 @@ def fit_g_sensitivity(
     return GSensitivity(coef[:, 1:], sd[:, 1:], coef[:, 0], chi, m - 4, m, cond)
 
 
+def combine_g_sensitivity(estimates: Sequence[GSensitivity]) -> tuple[FloatArray, FloatArray]:
+    """One ``A`` from the estimates of several sessions (one per temperature): each element
+    the inverse-variance weighted mean, its σ that of the mean, scaled by the square root of
+    the sessions' reduced χ² about it when they scatter beyond their σ.
+
+    Parameters
+    ----------
+    estimates : sequence of GSensitivity
+        One or more sessions' estimates.
+
+    Returns
+    -------
+    matrix, sigma : numpy.ndarray, shape (3, 3)
+        ``A`` and its standard uncertainty [°/h per g].
+
+    Raises
+    ------
+    ValueError
+        No estimate.
+
+    Notes
+    -----
+    Per element, with :math:`w_r = 1/\\sigma_r^2` over the k sessions:
+
+    .. math::
+
+        \\bar A = \\frac{\\sum_r w_r A_r}{\\sum_r w_r}, \\qquad
+        \\sigma_{\\bar A} = \\Big(\\sum_r w_r\\Big)^{-1/2}
+        \\max\\Big(1, \\frac{\\sum_r w_r (A_r - \\bar A)^2}{k - 1}\\Big)^{1/2}
+
+    the weighted mean of a least-squares fit of a constant (Golub & Van Loan §5.3 with a
+    one-column design); the sensitivity is taken as constant in temperature.
+
+    References
+    ----------
+    - G. H. Golub and C. F. Van Loan, *Matrix Computations*, 4th ed., §5.3.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> one = GSensitivity(np.full((3, 3), 10.0), np.full((3, 3), 2.0), np.zeros(3),
+    ...                    np.ones(3), 2, 6, 1.0)
+    >>> two = GSensitivity(np.full((3, 3), 13.0), np.full((3, 3), 1.0), np.zeros(3),
+    ...                    np.ones(3), 2, 6, 1.0)
+    >>> a, s = combine_g_sensitivity([one, two])
+    >>> float(a[0, 0]), round(float(s[0, 0]), 4)
+    (12.4, 1.2)
+    """
+    if not estimates:
+        raise ValueError("combine_g_sensitivity: no estimate")
+    a = np.array([e.matrix_deg_h_g for e in estimates])
+    w = 1.0 / np.array([e.sigma_deg_h_g for e in estimates]) ** 2
+    mean: FloatArray = (w * a).sum(axis=0) / w.sum(axis=0)
+    sigma: FloatArray = 1.0 / np.sqrt(w.sum(axis=0))
+    if len(estimates) > 1:
+        chi = (w * (a - mean) ** 2).sum(axis=0) / (len(estimates) - 1)
+        sigma = sigma * np.sqrt(np.maximum(1.0, chi))
+    return mean, sigma
+
+
 def _solve_axis(
     x: FloatArray, y: FloatArray, var: FloatArray
 ) -> tuple[FloatArray, FloatArray, float]:
@@ -260,4 +321,11 @@ def _solve_axis(
     return c, np.sqrt(np.diag(cov)), chi
 
 
-__all__ = ["MAX_DESIGN_COND", "MIN_POSES", "SIGNIFICANT_SIGMA", "GSensitivity", "fit_g_sensitivity"]
+__all__ = [
+    "MAX_DESIGN_COND",
+    "MIN_POSES",
+    "SIGNIFICANT_SIGMA",
+    "GSensitivity",
+    "combine_g_sensitivity",
+    "fit_g_sensitivity",
+]

@@ -63,6 +63,7 @@ from thermocal.errors import (
     FileFormatError,
     MissingColumnError,
     MissingValueError,
+    ParameterError,
     PlausibilityWarning,
     ThermocalInputError,
     ThermocalWarning,
@@ -571,6 +572,8 @@ def compensate_channels(
         channel (``"deg/s,deg/s,deg/s,mg,mg,mg"``).
     chunk_rows, extrapolate, known_input, on_progress
         As :func:`compensate_file`.
+    g_sensitivity : {"apply", "off"}
+        A gyro triad's g-sensitivity taken off or not (:func:`compensate_triads`).
     signal_given : bool
         Whether the signal columns were named by the user (a missing one is then said as
         theirs, not the model's).
@@ -1084,6 +1087,8 @@ class TriadCompensation:
         Unit of the input columns.
     count_scale : float or None
         For raw counts, one count in ``unit`` (None: a physical unit).
+    g_sensitivity : bool
+        The gyro triad's g-sensitivity taken off (``A f``).
     """
 
     triad: str
@@ -1093,6 +1098,8 @@ class TriadCompensation:
     outside_range_fraction: float
     input_unit: str = ""
     count_scale: float | None = None
+    g_sensitivity: bool = False
+    """True when the triad's g-sensitivity ``A f`` was taken off (a gyro triad)."""
 
     def to_dict(self) -> dict[str, Any]:
         """The fields as a dict, for the JSON result."""
@@ -1139,6 +1146,7 @@ def compensate_triads(
     read: ReadOptions | None = None,
     *,
     chunk_rows: int = DEFAULT_CHUNK_ROWS,
+    g_sensitivity: str = "apply",
 ) -> list[TriadCompensation]:
     """Apply triad calibrations to a recording, in chunks with constant memory.
 
@@ -1152,6 +1160,11 @@ def compensate_triads(
         How the file is read (see below for ``signal_unit``).
     chunk_rows : int
         Rows read and written at a time (at least 2).
+    g_sensitivity : {"apply", "off"}
+        ``apply`` (default): a gyro triad's g-sensitivity ``A`` is taken off with the
+        accelerometer triad's compensated output; ``off``: not, and a triad none of whose
+        columns the recording holds is left out (a warning), so that a gyro-only recording
+        takes the gyro triad alone.
 
     Returns
     -------
@@ -1166,16 +1179,23 @@ def compensate_triads(
     thermocal.errors.UnitError
         Raw-count temperatures without a conversion, or raw counts for a triad calibrated
         without a count scale.
+    thermocal.errors.ThermocalInputError
+        A gyro triad with a g-sensitivity, to be applied, and no accelerometer triad in the
+        calibration or none of its columns in the recording.
 
     Notes
     -----
     For each triad and each of its axes a column
 
-    .. math:: x^{comp} = \\left[(I + E(T))^{-1} (x - b(T))\\right]_{axis}
+    .. math:: x^{comp} = \\left[(I + E(T))^{-1} (x - b(T) - A f)\\right]_{axis}
 
     in the column's own unit, ``T`` the triad's temperature column at each sample (clamped
     to the calibrated range, with a warning when samples leave it;
-    :func:`thermocal.turntable.thermal.correct`).
+    :func:`thermocal.turntable.thermal.correct`); ``A f`` only for a gyro triad with a
+    g-sensitivity ``A`` [its unit per g] (``Triad.g_sensitivity``; IEEE Std 952-1997 annex B,
+    IEEE Std 1431-2004), ``f`` the accelerometer triad's compensated output at the same
+    sample in g (g = 9.80665 m/s²): the gyro model is ``ω_raw = (I + E) ω + b + A f``, so
+    ``A f`` comes off before the scale and misalignment are undone.
     Raw-count columns of a triad calibrated on counts (``Triad.count_scale``) are
     converted first, ``x = count_scale · N``, and their ``_comp`` columns are in the
     triad's physical unit; raw counts for a triad without a count scale are refused.
@@ -1196,7 +1216,7 @@ def compensate_triads(
     check_not_input(dst, [src])
     _check_chunk_rows(chunk_rows)
     source = _open_source(src, fmt, r)
-    plans = [_triad_plan(tri, source.names, source.available, src) for tri in triads]
+    plans = _triad_plans(triads, source.names, source.available, src, g_sensitivity)
     resolved = _resolve_triads(source, plans, r.time_unit, r.signal_unit)
     out_info = _triad_output_info(source.info, source.time_col, resolved, plans)
     warn_formula_names(dst, source.names)
@@ -1222,7 +1242,7 @@ def compensate_triads(
         results.append(
             TriadCompensation(
                 p.tri.name, tuple(p.columns), tuple(p.comp_columns), p.out_unit, outside,
-                p.data_unit, p.count_scale,
+                p.data_unit, p.count_scale, p.force_from is not None,
             )
         )  # fmt: skip
     return results
@@ -1295,11 +1315,14 @@ def _write_triads(
                 _check_finite(v, f"temperature column {c!r}", src, row0)
                 _check_plausible(v[:, None], [c], v[:0], "deg/h", src, row0)
                 temps[c] = v
-            new: dict[str, FloatArray] = {}
-            for p in plans:
+            done: dict[int, FloatArray] = {}
+            for p in sorted(plans, key=lambda q: q.force_from is not None):  # accel first
                 temp = (temps[p.temperature] if p.temperature  # "": one temperature
                         else np.full(t.size, p.tri.model.tref_c))  # fmt: skip
-                new.update(p.correct(chunk, temp, src, row0, thermal))
+                force = None if p.force_from is None else done[id(p.force_from)]
+                done[id(p)] = p.correct(chunk, temp, src, row0, thermal, force)
+            new = {name: np.ascontiguousarray(done[id(p)][:, k])
+                   for p in plans for k, name in enumerate(p.comp_columns)}  # fmt: skip
             w.write(_append_columns(chunk, new))
             state.advance(t)
     finally:
@@ -1321,6 +1344,13 @@ class _TriadPlan:
     count_scale: float | None = None
     to_data: float = 1.0
     n_outside: int = 0
+    force_from: _TriadPlan | None = None
+    """The accelerometer triad whose output is the specific force of a gyro triad's
+    g-sensitivity (None: none applied)."""
+    to_g: float = 1.0
+    """Factor from ``force_from``'s output unit to g."""
+    a_out: FloatArray | None = None
+    """The g-sensitivity in the output unit per g (once resolved)."""
 
     def calibrated_unit(self) -> str:
         """The unit of the columns the triad was calibrated on (:meth:`Triad.calibrated_unit
@@ -1335,6 +1365,10 @@ class _TriadPlan:
         inp = self.tri.input_in([resolved.signals[c].unit for c in self.columns], str(src))
         self.data_unit, self.out_unit = inp.data_unit, inp.unit
         self.count_scale, self.to_data = inp.count_scale, inp.to_data
+        if self.force_from is not None:  # the accelerometer triad is resolved first
+            tri_to_out = float(units.convert(np.array([1.0]), self.tri.unit, self.out_unit)[0])
+            self.a_out = np.asarray(self.tri.g_sensitivity, dtype=np.float64) * tri_to_out
+            self.to_g = float(units.convert(np.array([1.0]), self.force_from.out_unit, "g")[0])
 
     def correct(
         self,
@@ -1343,8 +1377,11 @@ class _TriadPlan:
         src: Path,
         row0: int,
         thermal: Any,
-    ) -> dict[str, FloatArray]:
-        """The chunk's compensated columns (:func:`thermocal.turntable.thermal.correct`)."""
+        force: FloatArray | None = None,
+    ) -> FloatArray:
+        """The chunk's compensated samples (n, 3) (:func:`thermocal.turntable.thermal.correct`),
+        ``A f`` taken off first when ``force`` (the accelerometer triad's compensated output,
+        in its unit) is given."""
         x = np.empty((temp.size, 3))
         for k, c in enumerate(self.columns):
             v = numeric_column(chunk, c, src, row0)
@@ -1356,8 +1393,71 @@ class _TriadPlan:
             x[:, k] = v
         m = self.tri.model
         self.n_outside += int(np.count_nonzero((temp < m.t_lo_c) | (temp > m.t_hi_c)))
-        xc = thermal.correct(m, x, temp, self.to_data)
-        return {name: np.ascontiguousarray(xc[:, k]) for k, name in enumerate(self.comp_columns)}
+        if force is not None and self.a_out is not None:
+            x = x - (force * self.to_g) @ self.a_out.T
+        out: FloatArray = thermal.correct(m, x, temp, self.to_data)
+        return out
+
+
+G_SENSITIVITY_CHOICES = ("apply", "off")
+"""``g_sensitivity`` of :func:`compensate_triads`: a gyro triad's g-sensitivity applied or
+not."""
+
+
+def _triad_plans(
+    triads: Sequence[Any], names: Sequence[str], available: str, src: Path, g_sensitivity: str
+) -> list[_TriadPlan]:
+    """Each triad's plan (:func:`_triad_plan`); a gyro triad's g-sensitivity linked to the
+    accelerometer triad whose output is its specific force (``apply``), refused without
+    one; with ``off``, a triad none of whose columns are in the file left out (a warning).
+    Accelerometer plans come before the gyro plans that read them (resolved first)."""
+    if g_sensitivity not in G_SENSITIVITY_CHOICES:
+        raise ParameterError(
+            "g_sensitivity", f"{{name}} {g_sensitivity!r}: {' or '.join(G_SENSITIVITY_CHOICES)}"
+        )
+    apply = g_sensitivity == "apply"
+    keep = list(triads)
+    gone = [t for t in triads if not any(c in names for c in t.columns)]
+    if not apply and len(gone) < len(triads):
+        keep = [t for t in triads if all(t is not g for g in gone)]
+        for t in gone:
+            warnings.warn(
+                ThermocalWarning(
+                    f"{src}: none of the {t.name} triad's columns "
+                    f"({', '.join(map(repr, t.columns))}) is in the file: left out"
+                ),
+                stacklevel=4,
+            )
+    accel = next((t for t in keep if t.model.kind == "accel"), None)
+    for t in keep:
+        if apply and t.g_sensitivity is not None:
+            _check_force_source(t, accel, names, src)
+    plans = {id(t): _triad_plan(t, names, available, src) for t in keep}
+    for t in keep:
+        if apply and t.g_sensitivity is not None and accel is not None:
+            plans[id(t)].force_from = plans[id(accel)]
+    return sorted(plans.values(), key=lambda p: p.force_from is not None)
+
+
+def _check_force_source(gyro: Any, accel: Any, names: Sequence[str], src: Path) -> None:
+    """The gyro triad's g-sensitivity needs the accelerometer triad of its calibration and
+    that triad's columns in the recording; one line naming ``g_sensitivity`` otherwise."""
+    if accel is None:
+        raise ThermocalInputError.naming(
+            f"{src}: the {gyro.name} triad's g-sensitivity takes off A·f with the specific "
+            "force f of an accelerometer triad, and the calibration holds none; give "
+            "{g_sensitivity} off to compensate without it",
+            "g_sensitivity",
+        )
+    missing = [c for c in accel.columns if c not in names]
+    if missing:
+        raise ThermocalInputError.naming(
+            f"{src}: the {gyro.name} triad's g-sensitivity takes off A·f with the specific "
+            f"force f from the {accel.name} triad's columns "
+            f"{', '.join(map(repr, accel.columns))}, and {', '.join(map(repr, missing))} "
+            "is not in the file; give {g_sensitivity} off to compensate without it",
+            "g_sensitivity",
+        )
 
 
 def _triad_plan(tri: Any, names: Sequence[str], available: str, src: Path) -> _TriadPlan:
@@ -1474,6 +1574,7 @@ def compensate_calibration_file(
     extrapolate: bool = False,
     known_input: float = 0.0,
     on_progress: Callable[[int], None] | None = None,
+    g_sensitivity: str = "apply",
 ) -> CalibrationCompensation:
     """Apply a model or calibration file to a recording (``thermocal compensate``).
 
@@ -1496,6 +1597,8 @@ def compensate_calibration_file(
         to apply, ``("gx", "gy")`` (default all).
     chunk_rows, extrapolate, known_input, on_progress
         As :func:`compensate_file`.
+    g_sensitivity : {"apply", "off"}
+        A gyro triad's g-sensitivity taken off or not (:func:`compensate_triads`).
 
     Returns
     -------
@@ -1520,7 +1623,9 @@ def compensate_calibration_file(
                 f"{model_file}: a calibration with both triads and single channels is not "
                 "applied yet; split it"
             )
-        done = compensate_triads(cal.triads, path, out, read, chunk_rows=chunk_rows)
+        done = compensate_triads(
+            cal.triads, path, out, read, chunk_rows=chunk_rows, g_sensitivity=g_sensitivity
+        )
         return CalibrationCompensation(str(model_file), str(out), "triads", tuple(done))
     common: dict[str, Any] = dict(
         chunk_rows=chunk_rows, extrapolate=extrapolate, known_input=known_input,

@@ -26,6 +26,7 @@ from thermocal.errors import DesignError, ParameterError, ThermocalInputError, T
 from thermocal.inspection import saturated_mask
 from thermocal.models.calibration import Calibration, Triad
 from thermocal.multipos.calibrate import METHOD, SessionResult, calibrate_session
+from thermocal.multipos.gsens import SIGNIFICANT_SIGMA, combine_g_sensitivity
 from thermocal.multipos.poses import (
     DRIFT_DEG,
     MOTION_FRACTION,
@@ -43,6 +44,9 @@ from thermocal.readers.options import ReadOptions
 from thermocal.recording import Recording
 from thermocal.turntable import thermal
 from thermocal.writers import check_not_input
+
+G_SENSITIVITY_CHOICES = ("auto", "apply", "off")
+"""What ``multipos`` does with the gyro's g-sensitivity (:class:`MultiposOptions`)."""
 
 NO_TEMPERATURE_TREF_C = 25.0
 """TREF recorded for a calibration made without a temperature column (it applies
@@ -109,6 +113,11 @@ class MultiposOptions:
     ADC counts); None: none, or mid-scale found in unsigned counts (a warning)."""
     gyro_model: str = "full"
     """The gyro's elements of E fitted (:data:`thermocal.multipos.gyro.GYRO_MODELS`)."""
+    g_sensitivity: str = "auto"
+    """The gyro's g-sensitivity in the calibration (:data:`G_SENSITIVITY_CHOICES`): ``auto``
+    stores it (and ``compensate`` applies it) when an element is beyond
+    :data:`thermocal.multipos.gsens.SIGNIFICANT_SIGMA` σ, ``apply`` whenever the poses
+    separate it (refused where they do not), ``off`` never (it is still reported)."""
     read: ReadOptions | None = None
     """How to read a text log and its time (``rate_hz``: a sample counter, or samples at
     the nominal rate; ``names`` …), as every command reads it; its columns and units are
@@ -135,6 +144,17 @@ class MultiposOptions:
         """
         if self.gyro_model not in ("full", "scale"):
             raise ParameterError("gyro_model", f"{{name}} {self.gyro_model!r}: full or scale")
+        if self.g_sensitivity not in G_SENSITIVITY_CHOICES:
+            raise ParameterError(
+                "g_sensitivity",
+                f"{{name}} {self.g_sensitivity!r}: {', '.join(G_SENSITIVITY_CHOICES)}",
+            )
+        if self.g_sensitivity == "apply" and self.gyro is None:
+            raise ParameterError(
+                "g_sensitivity",
+                "{name} apply: the g-sensitivity is the gyro's; name its columns with {gyro} X,Y,Z",
+                ("gyro",),
+            )
         if self.gyro_model != "full" and self.gyro is None:
             raise ParameterError(
                 "gyro_model",
@@ -199,6 +219,45 @@ class SessionRun:
 
 
 @dataclass(frozen=True, eq=False)
+class StoredGSensitivity:
+    """The gyro's g-sensitivity over the sessions (:func:`combine_g_sensitivity
+    <thermocal.multipos.gsens.combine_g_sensitivity>`) and the decision to store it.
+
+    Attributes
+    ----------
+    matrix, sigma : numpy.ndarray, shape (3, 3) or None
+        ``A`` and its σ [``unit``]; None when no session separates it.
+    unit : str
+        The gyro's unit per g (``deg/s/g``).
+    stored : bool
+        Written into the calibration (and applied by ``compensate``).
+    why : str
+        Why (the option, the significance, or what the poses lack).
+    n_sessions : int
+        Sessions whose estimate entered the mean.
+    """
+
+    matrix: Any
+    sigma: Any
+    unit: str
+    stored: bool
+    why: str
+    n_sessions: int
+
+    def to_dict(self) -> dict[str, Any]:
+        """``matrix``, ``matrix_sigma`` (None when not estimated), ``unit``, ``stored``,
+        ``why``, ``n_sessions``."""
+        return {
+            "matrix": None if self.matrix is None else np.asarray(self.matrix).tolist(),
+            "matrix_sigma": None if self.sigma is None else np.asarray(self.sigma).tolist(),
+            "unit": self.unit,
+            "stored": self.stored,
+            "why": self.why,
+            "n_sessions": self.n_sessions,
+        }
+
+
+@dataclass(frozen=True, eq=False)
 class MultiposResult:
     """The result of :func:`calibrate_files`: the calibration written, each session run,
     each triad's thermal model, the units and the gravity used; :meth:`to_dict` is its one
@@ -222,6 +281,8 @@ class MultiposResult:
         The calibration file written.
     count_scales : dict
         ``{triad: (value, unit)}`` of the triads read as raw counts.
+    g_sensitivity : StoredGSensitivity or None
+        The gyro's g-sensitivity over the sessions and whether it was stored.
     """
 
     calibration: Calibration
@@ -232,6 +293,8 @@ class MultiposResult:
     gravity_m_s2: float
     output: Path
     count_scales: dict[str, tuple[float, str]]
+    g_sensitivity: StoredGSensitivity | None = None
+    """The gyro's g-sensitivity and whether the calibration holds it (None without a gyro)."""
 
     def to_dict(self, spell: Callable[[str], str] | None = None) -> dict[str, Any]:
         """The result as JSON types (what the ``multipos`` command prints as JSON).
@@ -257,6 +320,8 @@ class MultiposResult:
         for kind, (value, unit) in self.count_scales.items():
             if kind in out:  # raw counts: the figures are in the scale's unit
                 out[kind]["count_scale"] = {"value": value, "unit": unit}
+        if self.g_sensitivity is not None and "gyro" in out:
+            out["gyro"]["g_sensitivity"] = self.g_sensitivity.to_dict()
         out["output"] = str(self.output)
         return out
 
@@ -557,12 +622,62 @@ def _session(
     return SessionRun(path, res, t_range, det, offsets), au, gu
 
 
+def _g_sensitivity(
+    runs: list[SessionRun], opts: MultiposOptions, g_unit: str | None
+) -> tuple[StoredGSensitivity | None, list[SessionRun]]:
+    """The gyro's g-sensitivity over the sessions that separate it and the decision of
+    ``opts.g_sensitivity``; when stored, the sessions with each gyro bias moved to zero
+    specific force (:func:`_zero_force_bias`), for the thermal fit."""
+    if opts.gyro is None or g_unit is None:
+        return None, runs
+    unit = f"{g_unit}/g"
+    found = [r.result.g_sensitivity for r in runs if r.result.g_sensitivity is not None]
+    if not found:
+        note = next((r.result.g_sensitivity_note for r in runs), None) or "not estimated"
+        if opts.g_sensitivity == "apply":
+            raise DesignError.naming(
+                f"{runs[0].path}: {{g_sensitivity}} apply: {note}", "g_sensitivity"
+            )
+        return StoredGSensitivity(None, None, unit, False, f"not estimated: {note}", 0), runs
+    a, sig = combine_g_sensitivity(found)
+    beyond = bool(np.any(np.abs(a) > SIGNIFICANT_SIGMA * sig))
+    store = opts.g_sensitivity == "apply" or (opts.g_sensitivity == "auto" and beyond)
+    why = {
+        "apply": "stored as asked (apply)",
+        "off": "not stored (off)",
+        "auto": f"stored: an element is beyond {SIGNIFICANT_SIGMA:g}σ"
+        if beyond
+        else f"not stored: no element beyond {SIGNIFICANT_SIGMA:g}σ",
+    }[opts.g_sensitivity]
+    to_g = float(units.convert(np.array([1.0]), "deg/h", g_unit)[0])
+    stored = StoredGSensitivity(a * to_g, sig * to_g, unit, store, why, len(found))
+    return stored, [_zero_force_bias(r, a, sig) for r in runs] if store else runs
+
+
+def _zero_force_bias(run: SessionRun, a_deg_h_g: np.ndarray, sig_deg_h_g: np.ndarray) -> SessionRun:
+    """The session with its gyro bias at zero specific force: the static bias is the poses'
+    sample-weighted mean rate (:func:`thermocal.multipos.gyro.static_bias`), which holds
+    ``A f̄`` with ``f̄`` their sample-weighted mean specific force [g], taken from the poses'
+    means less the accelerometer's bias; ``b₀ = b − A f̄``, ``σ²(b₀) = σ²(b) + σ²(A) f̄²``."""
+    r = run.result
+    assert r.gyro is not None
+    n = np.array([p.section.n for p in r.poses], dtype=np.float64)
+    f_mg = np.array([p.f_mean_mg for p in r.poses]) - r.accel.theta[0:3]
+    f_bar = np.average(f_mg, axis=0, weights=n) / units.G_TO_MG
+    theta = r.gyro.theta.copy()
+    theta[0:3] -= a_deg_h_g @ f_bar
+    cov = r.gyro.cov.copy()
+    cov[0:3, 0:3] += np.diag(sig_deg_h_g**2 @ f_bar**2)
+    return replace(run, result=replace(r, gyro=replace(r.gyro, theta=theta, cov=cov)))
+
+
 def _fit_triads(
     runs: list[SessionRun],
     opts: MultiposOptions,
     a_unit: str,
     g_unit: str | None,
     grav: _Gravity,
+    g_sens: StoredGSensitivity | None = None,
 ) -> tuple[list[Triad], dict[str, Any]]:
     """Each triad's thermal model: a polynomial in T − TREF over several sessions, else
     the one session's parameters as constants."""
@@ -591,12 +706,15 @@ def _fit_triads(
             )  # fmt: skip
         models[kind] = m
         sc = opts.accel_scale if kind == "accel" else opts.gyro_scale
+        stored = g_sens if kind == "gyro" and g_sens is not None and g_sens.stored else None
         triads.append(
             Triad(
                 kind, (cols[0], cols[1], cols[2]), unit, opts.temps or "", m,
                 latitude_deg=grav.latitude_deg, count_scale=None if sc is None else sc[0],
                 data=tuple({"file": Path(r.path).name, "sha256": file_sha256(r.path)}
                            for r in runs),
+                g_sensitivity=None if stored is None else stored.matrix,
+                g_sensitivity_sigma=None if stored is None else stored.sigma,
             )
         )  # fmt: skip
     return triads, models
@@ -656,7 +774,8 @@ def calibrate_files(
             raise ThermocalInputError(f"the files' {what} columns differ in unit: {sorted(found)}")
     a_unit = a_units.pop()
     g_unit = g_units.pop() if g_units else None
-    triads, models = _fit_triads(runs, opts, a_unit, g_unit, grav)
+    g_sens, fit_runs = _g_sensitivity(runs, opts, g_unit)
+    triads, models = _fit_triads(fit_runs, opts, a_unit, g_unit, grav, g_sens)
     cal = Calibration([], triads)
     check_as_read(cal, output, "check the columns' units ({accel_unit}, {gyro_unit}, "
                   "{accel_scale}, {gyro_scale}) and the poses ({poses}), or fit a lower "
@@ -667,7 +786,7 @@ def calibrate_files(
     scales = {"accel": opts.accel_scale, "gyro": opts.gyro_scale}
     return MultiposResult(
         cal, tuple(runs), models, a_unit, g_unit, float(grav.g_m_s2), output,
-        {k: sc for k, sc in scales.items() if sc is not None},
+        {k: sc for k, sc in scales.items() if sc is not None}, g_sens,
     )  # fmt: skip
 
 

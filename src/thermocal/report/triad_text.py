@@ -104,7 +104,37 @@ def g_sensitivity_line(run: dict[str, Any]) -> str | None:
     if not found:
         worst = max(max(row) for row in gs["matrix_sigma"])
         return head + f"none beyond 3σ (σ ≤ {fmt(worst, 2)})"
-    return head + "; ".join(found) + " (beyond 3σ; not compensated by this calibration)"
+    return head + "; ".join(found) + " (beyond 3σ)"
+
+
+def g_sensitivity_stored_line(out: dict[str, Any]) -> str | None:
+    """Whether the calibration holds the gyro's g-sensitivity (``compensate`` then takes
+    ``A f`` off), and why; None without a gyro.
+
+    Parameters
+    ----------
+    out : dict
+        A multi-position result's JSON object (its ``gyro.g_sensitivity``).
+
+    Returns
+    -------
+    str or None
+
+    References
+    ----------
+    IEEE Std 952-1997, annex B (acceleration-sensitive drift).
+    """
+    gs = out.get("gyro", {}).get("g_sensitivity")
+    if gs is None:
+        return None
+    if not gs["stored"]:
+        return f"gyro g-sensitivity {gs['why']}: compensate leaves it in"
+    worst = max(abs(v) for row in gs["matrix"] for v in row)
+    return (
+        f"gyro g-sensitivity {gs['why']} (largest |A| {fmt(worst, 3)} {gs['unit']}, over "
+        f"{gs['n_sessions']} session(s)): compensate takes A·f off with the accelerometer's "
+        "specific force; the gyro bias is that at zero specific force"
+    )
 
 
 def pose_detection_lines(out: dict[str, Any]) -> list[str]:
@@ -199,6 +229,8 @@ def multipos_summary_text(out: dict[str, Any], a_unit: str, output: Path | str) 
         f"{fmt(out['gravity_residual_rms_before'], 3)} → "
         f"{fmt(out['gravity_residual_rms_after'], 3)} {a_unit}; written {output}"
     )
+    stored = g_sensitivity_stored_line(out)
+    blocks += [stored] if stored is not None else []
     for run in out["runs"]:
         line = gyro_misfit_line(run)
         blocks += [line] if line is not None else []
