@@ -286,6 +286,20 @@ def _lost_notes(t: TriadFirmware) -> list[str]:
     return out
 
 
+def _g_sensitivity_notes(triad: Triad) -> list[str]:
+    """A gyro triad's g-sensitivity, which no firmware parameter holds (also warned)."""
+    if triad.g_sensitivity is None:
+        return []
+    a = np.asarray(triad.g_sensitivity, dtype=np.float64)
+    worst = float(np.max(np.linalg.norm(a, axis=1)))
+    return [
+        f"{triad.name}: the g-sensitivity A (rows up to {worst:.4g} {triad.g_sensitivity_unit}) "
+        "is not held (the firmware has no gyro term in the specific force): the offsets are "
+        "the bias at zero specific force, and at rest the gyro reads A·f more, up to "
+        f"{worst:.4g} {triad.unit} at 1 g"
+    ]
+
+
 def _triads_of(
     cal: Calibration, gyro: Sequence[str] | None, accel: Sequence[str] | None
 ) -> dict[str, Triad]:
@@ -386,7 +400,7 @@ def triad_params(
             params[n], types[n] = v, 9
         for n, v in zip(scales or [], t.scale, strict=False):
             params[n], types[n] = v, 9
-        lost = _lost_notes(t)
+        lost = _lost_notes(t) + _g_sensitivity_notes(triads[kind])
         for line in lost:
             warnings.warn(line, ThermocalWarning, stacklevel=2)
         notes += lost

@@ -8,6 +8,15 @@ calibrated range, every parameter a polynomial in ``T − TREF`` (Horner), ``E``
 determinant (no allocation, no library call; ``I + E`` is within 10⁻³ of the identity, so
 the determinant is near 1).  Matches :func:`thermocal.turntable.thermal.correct`.
 
+A gyro triad with a g-sensitivity ``A`` (``Triad.g_sensitivity``) takes a third input,
+
+    void <p>_<triad>_correct(double temp_c, const <real> x[3], const <real> f[3], <real> out[3]);
+
+``f`` the accelerometer triad's corrected output in its unit (the specific force; in g when
+the calibration holds no accelerometer triad), and computes ``out = (I + E(T))⁻¹ (x − b(T) −
+A f)`` with ``f`` converted to g, as :func:`thermocal.pipeline.compensate.compensate_triads`:
+call the accelerometer's function first.
+
 A triad calibrated on raw counts (``accel_scale``/``gyro_scale`` of the multi-position
 calibration) takes ``x`` in its physical unit all the same; the header defines the count scale
 ``<P>_<TRIAD>_COUNT_SCALE`` (one count in that unit) and states the conversion
@@ -31,15 +40,56 @@ def _lit(x: float) -> str:
     return repr(float(x))
 
 
-def _triad_code(p: str, tri: Any, bias_to_data: float, real: str, ident: str) -> tuple[str, str]:
+def _force(p: str, tri: Any, force_unit: str | None, real: str) -> tuple[list[str], str, str]:
+    """A gyro triad's g-sensitivity in C: its constants (``A`` in the triad's unit per g and
+    the factor from the force's unit to g), the extra parameter and the comment; nothing
+    for a triad without one."""
+    if tri.g_sensitivity is None:
+        return [], "", ""
+    to_g = float(units.convert([1.0], force_unit, "g")[0]) if force_unit else 1.0
+    what = (
+        f"the accelerometer triad's corrected output [{c_comment(force_unit)}]"
+        if force_unit
+        else "the specific force [g]"
+    )
+    rows = [
+        "    {" + ", ".join(_lit(v) for v in row) + "},"
+        for row in tri.g_sensitivity  # row: gyro axis; column: the force's axis
+    ]
+    consts = [
+        f"/* g-sensitivity A [{c_comment(tri.unit)} per g]: row the gyro axis, column the "
+        "specific force's */",
+        f"static const double {p}_GSENS[3][3] = {{",
+        *rows,
+        "};",
+        f"/* f: {what}; to g (9.80665 m/s^2) */",
+        f"static const double {p}_FORCE_TO_G = {_lit(to_g)};",
+    ]
+    return consts, f", const {real} f[3]", f"; A f taken off first, f {what}"
+
+
+def _gsens_term(p: str, i: int) -> str:
+    """``- (A f)_i`` of row ``i`` (``f`` converted to g)."""
+    return (
+        f" - {p}_FORCE_TO_G * ({p}_GSENS[{i}][0] * (double)f[0] + {p}_GSENS[{i}][1] * "
+        f"(double)f[1] + {p}_GSENS[{i}][2] * (double)f[2])"
+    )
+
+
+def _triad_code(
+    p: str, tri: Any, bias_to_data: float, real: str, ident: str, force_unit: str | None = None
+) -> tuple[str, str]:
     """(declaration, definition) of one triad's correction function (``ident``: the triad's
-    name through :func:`thermocal.identifiers.c_identifier`)."""
+    name through :func:`thermocal.identifiers.c_identifier`; ``force_unit`` the
+    accelerometer triad's unit a gyro's g-sensitivity takes its force in, None: in g)."""
     m = tri.model
     name = f"{p}_{ident}"  # two identifiers of the gate joined by '_': an identifier
     label = c_comment(tri.name)
     bias_unit = "deg/h" if m.kind == "gyro" else "mg"
     P = name.upper()
     order = max(len(f.coef) for f in m.fits)
+    consts, f_arg, f_about = _force(P, tri, force_unit, real)
+    gs = [_gsens_term(P, i) if f_arg else "" for i in range(3)]
     rows = []
     for f in m.fits:
         c = [float(v) for v in f.coef] + [0.0] * (order - len(f.coef))
@@ -60,8 +110,9 @@ def _triad_code(p: str, tri: Any, bias_to_data: float, real: str, ident: str) ->
         f"static const double {P}_T_HI = {_lit(m.t_hi_c)};",
         f"/* bias unit ({bias_unit}) to the data's unit ({c_comment(tri.unit)}) */",
         f"static const double {P}_BIAS_TO_DATA = {_lit(bias_to_data)};",
+        *consts,
         "",
-        f"void {name}_correct(double temp_c, const {real} x[3], {real} out[3])",
+        f"void {name}_correct(double temp_c, const {real} x[3]{f_arg}, {real} out[3])",
         "{",
         f"    double t = temp_c < {P}_T_LO ? {P}_T_LO : (temp_c > {P}_T_HI ? {P}_T_HI : temp_c);",
         f"    double dt = t - {P}_TREF;",
@@ -81,9 +132,9 @@ def _triad_code(p: str, tri: Any, bias_to_data: float, real: str, ident: str) ->
         i, j = tt_model.MISALIGNMENT_INDEX[mis]
         lines.append(f"    m[{i}][{j}] = th[{6 + k}] * {_lit(units.ARCSEC_TO_RAD)}; /* {mis} */")
     lines += [
-        f"    r[0] = (double)x[0] - th[0] * {P}_BIAS_TO_DATA;",
-        f"    r[1] = (double)x[1] - th[1] * {P}_BIAS_TO_DATA;",
-        f"    r[2] = (double)x[2] - th[2] * {P}_BIAS_TO_DATA;",
+        f"    r[0] = (double)x[0] - th[0] * {P}_BIAS_TO_DATA{gs[0]};",
+        f"    r[1] = (double)x[1] - th[1] * {P}_BIAS_TO_DATA{gs[1]};",
+        f"    r[2] = (double)x[2] - th[2] * {P}_BIAS_TO_DATA{gs[2]};",
         "    det = m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1])",
         "        - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0])",
         "        + m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]);",
@@ -99,7 +150,8 @@ def _triad_code(p: str, tri: Any, bias_to_data: float, real: str, ident: str) ->
         "}",
     ]
     about = c_comment(
-        f"{tri.name}: out = (I + E(T))^-1 (x - b(T)) in {tri.unit}; columns "
+        f"{tri.name}: out = (I + E(T))^-1 (x - b(T){' - A f' if f_arg else ''}) in "
+        f"{tri.unit}{f_about}; columns "
         f"{', '.join(map(str, tri.columns))}; "
         + (
             f"T [degC] of {tri.temperature}, clamped to [{m.t_lo_c:g}, {m.t_hi_c:g}]"
@@ -118,7 +170,7 @@ def _triad_code(p: str, tri: Any, bias_to_data: float, real: str, ident: str) ->
             f" * registers first, x[i] = {P}_COUNT_SCALE * counts[i] [{unit}] */\n"
             f"#define {P}_COUNT_SCALE {_lit(tri.count_scale)}\n"
         )
-    decl += f"void {name}_correct(double temp_c, const {real} x[3], {real} out[3]);"
+    decl += f"void {name}_correct(double temp_c, const {real} x[3]{f_arg}, {real} out[3]);"
     return decl, "\n".join(lines)
 
 
@@ -148,7 +200,9 @@ def generate_c_triads(triads: Sequence[Any], *, prefix: str, real: str = "double
 
     Notes
     -----
-    .. math:: \mathbf{out} = (I + E(T))^{-1}\,(\mathbf x - \mathbf b(T))
+    .. math:: \mathbf{out} = (I + E(T))^{-1}\,(\mathbf x - \mathbf b(T) - A \mathbf f)
+
+    ``A f`` only for a gyro triad with a g-sensitivity (module docstring).
 
     References
     ----------
@@ -161,11 +215,12 @@ def generate_c_triads(triads: Sequence[Any], *, prefix: str, real: str = "double
     used: dict[str, str] = {}
     decls, defs = [], []
     seen = {f"{p.upper()}_H": "the guard of the file"}
+    accel = next((t for t in triads if t.model.kind == "accel"), None)
     for tri in triads:
         bias_unit = "deg/h" if tri.model.kind == "gyro" else "mg"
         factor = float(units.convert([1.0], bias_unit, tri.unit)[0])
         ident = c_identifier(tri.name, used, what="triad")
-        d, f = _triad_code(p, tri, factor, real, ident)
+        d, f = _triad_code(p, tri, factor, real, ident, None if accel is None else accel.unit)
         for n in c_names(d + "\n" + f, f"{p}_{ident}"):
             if seen.setdefault(n, f"triad {tri.name!r}") != f"triad {tri.name!r}":
                 raise ThermocalInputError(
