@@ -17,6 +17,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 import pytest
+
 from gsens_session import (
     A_TRUE,
     GYRO_NOISE_DEG_S,
@@ -27,7 +28,6 @@ from gsens_session import (
     run,
     write_session,
 )
-
 from thermocal import units
 from thermocal.models.calibration import Calibration, Triad
 from thermocal.pipeline.model_file import save_calibration
