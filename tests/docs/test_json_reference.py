@@ -222,6 +222,15 @@ def _imu_runs(t: Path) -> list[tuple[str, Any]]:
     ]  # fmt: skip
 
 
+def _timed_ferraris(t: Path) -> str:
+    """imucal's session with a time column (its sample counter over 102.4 Hz): a file a
+    calibration of triads is applied to."""
+    lines = (FERRARIS / "example_ferraris_session.csv").read_text().splitlines()
+    rows = [f"time_s,{lines[0]}"] + [f"{int(ln.split(',')[0]) / 102.4!r},{ln}" for ln in lines[1:]]
+    (t / "ferraris-timed.csv").write_text("\n".join(rows) + "\n")
+    return str(t / "ferraris-timed.csv")
+
+
 def _other_runs(t: Path) -> list[tuple[str, Any]]:
     """Flight-controller logs, the turntable, multipos, a batch and the demonstrations."""
     _run(["simulate", "turntable-16", "-o", str(t / "tt.csv")])
@@ -247,6 +256,8 @@ def _other_runs(t: Path) -> list[tuple[str, Any]]:
                            "--accel-unit", "m/s^2", "--gyro", "gyr_x,gyr_y,gyr_z",
                            "--gyro-unit", "deg/s", "--gravity", "9.81",
                            "-o", str(t / "mp.json")])),
+        ("compensate", _run(["compensate", str(t / "mp.json"), _timed_ferraris(t),
+                             "--time", "time_s", "-o", str(t / "mp-comp.csv")])),
         ("ratetable", _run(["ratetable", *rt, "--rate-column", "table_rate", "--temps", "temp"])),
         ("fleet", _run(["fleet", str(t / "batch.toml"), "-o", str(t / "bo"), "--workers", "1"])),
         ("demo", _run(["demo", "--quick", "-o", str(t / "d1")])),
