@@ -94,3 +94,15 @@ def test_a_doubtful_one_is_refused(change: Any, words: tuple[str, ...]) -> None:
         calibration_from_dict(_resummed(d), "c.json")
     for w in words:
         assert w in str(err.value), (w, str(err.value))
+
+
+def test_the_term_in_the_columns_units() -> None:
+    """``A f`` of a triad in deg/s with the force in m/s² and the columns in rad/s:
+    (f / 9.80665) A^T π/180, written here; zeros without a g-sensitivity."""
+    tri = _cal(True).triads[1]
+    f = np.array([[0.0, 0.0, 9.80665], [4.0, -3.0, 8.5], [-9.0, 1.0, 0.2]])
+    want = (f / 9.80665) @ A.T * np.pi / 180.0
+    np.testing.assert_allclose(tri.g_sensitivity_term(f, "m/s^2", "rad/s"), want, rtol=1e-12)
+    np.testing.assert_allclose(tri.g_sensitivity_term(f * 1e3 / 9.80665, "mg", "deg/s"),
+                               want * 180.0 / np.pi, rtol=1e-12)  # fmt: skip
+    np.testing.assert_array_equal(_cal(False).triads[1].g_sensitivity_term(f, "g", "deg/s"), 0.0)

@@ -204,6 +204,44 @@ class Triad:
         (``deg/s/g``)."""
         return f"{self.unit}/g"
 
+    def g_sensitivity_term(self, force: Any, force_unit: str, unit: str) -> FloatArray:
+        """``A f`` per sample in ``unit``: the rate a gyro triad with a g-sensitivity reads
+        more under the specific force ``force`` (the accelerometer triad's compensated
+        output, in ``force_unit``), the one formula of ``compensate`` and ``validate``.
+
+        Parameters
+        ----------
+        force : array_like, shape (n, 3)
+            The specific force [``force_unit``: g, mg or m/s²].
+        force_unit : str
+            Its unit (converted to g = 9.80665 m/s²).
+        unit : str
+            The rate unit of the result (the gyro columns' physical unit).
+
+        Returns
+        -------
+        numpy.ndarray, shape (n, 3)
+            ``A f`` [``unit``]; zeros for a triad without a g-sensitivity.
+
+        Notes
+        -----
+        .. math:: (A f)_i = \\sum_j A_{ij} f_j, \\qquad f_j \\text{ in g}
+
+        References
+        ----------
+        - IEEE Std 952-1997, annex B (acceleration-sensitive drift).
+        """
+        from thermocal import units
+
+        f = np.asarray(force, dtype=np.float64)
+        if self.g_sensitivity is None:
+            return np.zeros_like(f)
+        to_g = float(units.convert(np.array([1.0]), force_unit, "g")[0])
+        to_unit = float(units.convert(np.array([1.0]), self.unit, unit)[0])
+        a = np.asarray(self.g_sensitivity, dtype=np.float64) * to_unit
+        out: FloatArray = (f * to_g) @ a.T
+        return out
+
     def calibrated_unit(self) -> str:
         """The unit of the columns the triad was calibrated on: raw counts for a triad with
         a count scale, else its unit (the unit of a column that states none).

@@ -153,7 +153,9 @@ def validate_held_out_session(
         xg, g_in = triad_columns(rec, gyr, unit_opts)
         g_unit = g_in.unit
         tg = temp_of(gyr)
-        xg_c = thermal.correct(gyr.model, xg, tg, g_in.to_data)
+        # its g-sensitivity taken off with the accelerometer's output, as compensate does
+        af = gyr.g_sensitivity_term(xa_c, a_unit, g_unit)
+        xg_c = thermal.correct(gyr.model, xg - af, tg, g_in.to_data)
         xg = units.convert(xg, g_unit, "rad/s")
         xg_c = units.convert(xg_c, g_unit, "rad/s")
     sections = detect_poses(t, xa, xg, static_s=static_s)

@@ -1347,10 +1347,6 @@ class _TriadPlan:
     force_from: _TriadPlan | None = None
     """The accelerometer triad whose output is the specific force of a gyro triad's
     g-sensitivity (None: none applied)."""
-    to_g: float = 1.0
-    """Factor from ``force_from``'s output unit to g."""
-    a_out: FloatArray | None = None
-    """The g-sensitivity in the output unit per g (once resolved)."""
 
     def calibrated_unit(self) -> str:
         """The unit of the columns the triad was calibrated on (:meth:`Triad.calibrated_unit
@@ -1365,10 +1361,6 @@ class _TriadPlan:
         inp = self.tri.input_in([resolved.signals[c].unit for c in self.columns], str(src))
         self.data_unit, self.out_unit = inp.data_unit, inp.unit
         self.count_scale, self.to_data = inp.count_scale, inp.to_data
-        if self.force_from is not None:  # the accelerometer triad is resolved first
-            tri_to_out = float(units.convert(np.array([1.0]), self.tri.unit, self.out_unit)[0])
-            self.a_out = np.asarray(self.tri.g_sensitivity, dtype=np.float64) * tri_to_out
-            self.to_g = float(units.convert(np.array([1.0]), self.force_from.out_unit, "g")[0])
 
     def correct(
         self,
@@ -1393,8 +1385,8 @@ class _TriadPlan:
             x[:, k] = v
         m = self.tri.model
         self.n_outside += int(np.count_nonzero((temp < m.t_lo_c) | (temp > m.t_hi_c)))
-        if force is not None and self.a_out is not None:
-            x = x - (force * self.to_g) @ self.a_out.T
+        if force is not None and self.force_from is not None:  # A f off (Triad.g_sensitivity)
+            x = x - self.tri.g_sensitivity_term(force, self.force_from.out_unit, self.out_unit)
         out: FloatArray = thermal.correct(m, x, temp, self.to_data)
         return out
 
