@@ -1227,6 +1227,14 @@ def compensate_triads(
     )  # fmt: skip
     if _CHUNK_WRITERS[kind_out].sidecar:
         write_json(sidecar_path(dst), out_info)
+    return _triad_results(plans, state, src)
+
+
+def _triad_results(
+    plans: Sequence[_TriadPlan], state: _PassState, src: Path
+) -> list[TriadCompensation]:
+    """What :func:`compensate_triads` did per triad, with a warning for a triad whose
+    samples left its calibrated temperature range."""
     results = []
     for p in plans:
         outside = p.n_outside / max(state.rows, 1)
@@ -1237,7 +1245,7 @@ def compensate_triads(
                     f"triad's calibrated range {p.tri.model.t_lo_c:g}…{p.tri.model.t_hi_c:g} "
                     "°C: its parameters are held at the nearest end there"
                 ),
-                stacklevel=2,
+                stacklevel=3,
             )
         results.append(
             TriadCompensation(
