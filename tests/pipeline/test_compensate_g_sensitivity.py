@@ -23,6 +23,7 @@ from gsens_session import (
     GYRO_NOISE_DEG_S,
     GYRO_THETA,
     LATITUDE_DEG,
+    MULTIPOS,
     READ,
     calibrate,
     run,
@@ -188,3 +189,21 @@ def test_the_formula_in_other_units(tmp_path: Path) -> None:
     want = np.linalg.solve(np.eye(3) + eg, (gyr - tg[0:3] * dh_rs - f_ms2 / 9.80665 @ a_rad.T).T).T
     np.testing.assert_allclose(out[["ax_comp", "ay_comp", "az_comp"]], f_ms2, rtol=1e-12)
     np.testing.assert_allclose(out[["gx_comp", "gy_comp", "gz_comp"]], want, rtol=1e-10, atol=1e-15)
+
+
+def test_the_text_says_what_was_stored_and_applied(session: dict[str, Any]) -> None:
+    d = session["dir"]
+    code, out, err = run(["compensate", str(d / "cal.json"), str(d / "s.csv"), "-o",
+                          str(d / "text.csv"), *READ])  # fmt: skip
+    assert code == 0, err
+    text = " ".join(out.split())
+    assert "gyro: gx_comp, gy_comp, gz_comp [deg/s] (g-sensitivity A·f taken off)" in text
+    assert "accel: ax_comp, ay_comp, az_comp [mg]" in text and text.count("A·f") == 1
+    code, out, err = run(["multipos", str(d / "s.csv"), *MULTIPOS, "-o", str(d / "t.json")])
+    assert code == 0, err
+    largest = float(np.max(np.abs(json.loads((d / "t.json").read_text())["triads"][1][
+        "g_sensitivity"])))  # fmt: skip
+    assert (
+        "gyro g-sensitivity stored: an element is beyond 3σ (largest |A| "
+        f"{largest:.3g} deg/s/g, over 1 session(s)): compensate takes A·f off"
+    ) in " ".join(out.split())
