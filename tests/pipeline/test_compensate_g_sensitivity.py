@@ -207,3 +207,25 @@ def test_the_text_says_what_was_stored_and_applied(session: dict[str, Any]) -> N
         "gyro g-sensitivity stored: an element is beyond 3σ (largest |A| "
         f"{largest:.3g} deg/s/g, over 1 session(s)): compensate takes A·f off"
     ) in " ".join(out.split())
+
+
+def test_a_gyro_triad_alone_with_a_is_refused_then_taken_with_off(tmp_path: Path) -> None:
+    """A calibration holding the gyro triad only (no accelerometer to give f)."""
+    tg = np.zeros(12)
+    tg[0:3] = [36.0, -72.0, 18.0]  # °/h
+    model = thermal.constant_triad("gyro", 25.0, tg, np.eye(12), method="multipos")
+    gyro = Triad("gyro", ("gx", "gy", "gz"), "deg/s", "", model, g_sensitivity=np.eye(3) * 0.01,
+                 g_sensitivity_sigma=np.full((3, 3), 1e-4))  # fmt: skip
+    save_calibration(Calibration([], [gyro]), tmp_path / "g.json")
+    pd.DataFrame({"t": [0.0, 0.01, 0.02], "gx": [0.1, 0.2, 0.3], "gy": [0.0] * 3,
+                  "gz": [1.0] * 3}).to_csv(tmp_path / "r.csv", index=False)  # fmt: skip
+    args = ["compensate", str(tmp_path / "g.json"), str(tmp_path / "r.csv"), *READ,
+            "--signal-unit", "deg/s"]  # fmt: skip
+    code, _o, err = run([*args, "-o", str(tmp_path / "a.csv")])
+    errors = [ln for ln in err.splitlines() if ln.startswith("error:")]
+    assert code == 2 and len(errors) == 1, err
+    assert "holds none" in errors[0] and "--g-sensitivity off" in errors[0], errors[0]
+    code, _o, err = run([*args, "-o", str(tmp_path / "b.csv"), "--g-sensitivity", "off"])
+    assert code == 0, err
+    out = pd.read_csv(tmp_path / "b.csv")
+    np.testing.assert_allclose(out["gx_comp"], np.array([0.1, 0.2, 0.3]) - 0.01, rtol=1e-12)
