@@ -229,3 +229,30 @@ def test_a_gyro_triad_alone_with_a_is_refused_then_taken_with_off(tmp_path: Path
     assert code == 0, err
     out = pd.read_csv(tmp_path / "b.csv")
     np.testing.assert_allclose(out["gx_comp"], np.array([0.1, 0.2, 0.3]) - 0.01, rtol=1e-12)
+
+
+def test_two_sessions_give_one_a(tmp_path: Path) -> None:
+    """Two sessions of the sensor at 20 and 40 °C (no temperature dependence simulated):
+    one A from both (n_sessions 2, within 4σ of the truth), the gyro's bias polynomial fitted
+    on the biases at zero force (its value at TREF within 4σ of the truth)."""
+    files = []
+    for k, (seed, temp) in enumerate(((5, 20.0), (11, 40.0))):
+        d = tmp_path / f"s{k}"
+        d.mkdir()
+        write_session(d, seed=seed)
+        data = pd.read_csv(d / "s.csv")
+        data["T"] = temp
+        data.to_csv(d / "s.csv", index=False)
+        files.append(str(d / "s.csv"))
+    code, out, err = run(["multipos", *files, *MULTIPOS, "--temps", "T", "--order", "0",
+                          "-o", str(tmp_path / "cal.json"), "--json"])  # fmt: skip
+    assert code == 0, err
+    g = json.loads(out)["gyro"]
+    gs = g["g_sensitivity"]
+    assert gs["stored"] and gs["n_sessions"] == 2
+    a, s = np.array(gs["matrix"]), np.array(gs["matrix_sigma"])
+    assert np.all(np.abs(a - A_TRUE / 3600.0) < 4.0 * s), (a * 3600, s * 3600)
+    runs = [np.array(r["gyro"]["g_sensitivity"]["matrix_sigma"]) for r in json.loads(out)["runs"]]
+    assert np.all(s < np.minimum(runs[0], runs[1]))  # two sessions: tighter than either
+    b, sb = np.array(g["bias"]), np.array(g["bias_sigma"])
+    assert np.all(np.abs(b - GYRO_THETA[0:3] / 3600.0) < 4.0 * sb), (b * 3600, sb * 3600)
