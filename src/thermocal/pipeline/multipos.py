@@ -651,7 +651,15 @@ def _g_sensitivity(
     }[opts.g_sensitivity]
     to_g = float(units.convert(np.array([1.0]), "deg/h", g_unit)[0])
     stored = StoredGSensitivity(a * to_g, sig * to_g, unit, store, why, len(found))
-    return stored, [_zero_force_bias(r, a, sig) for r in runs] if store else runs
+    if not store:
+        return stored, runs
+    # a session whose rates had A f(t) taken off before its gyro fit (where calibrate_session
+    # does that, SessionResult.g_sensitivity_subtracted) has its bias at zero force already:
+    # moved only where that was not done
+    return stored, [
+        r if getattr(r.result, "g_sensitivity_subtracted", False) else _zero_force_bias(r, a, sig)
+        for r in runs
+    ]
 
 
 def _zero_force_bias(run: SessionRun, a_deg_h_g: np.ndarray, sig_deg_h_g: np.ndarray) -> SessionRun:
