@@ -30,7 +30,7 @@ from thermocal.readers.common import (
     short_name,
 )
 from thermocal.readers.formats import TEXT_FIELDS, FileFormat, format_of, registered_formats
-from thermocal.readers.options import ReadOptions
+from thermocal.readers.options import CHAMBER_COLUMN, ReadOptions
 from thermocal.readers.station import is_station_path
 from thermocal.readers.table import (
     ON_DEMAND_MIN_COLUMNS,
@@ -630,6 +630,10 @@ def read_recording(
     """
     p = Path(path)
     r = read or ReadOptions()
+    chamber, asked = r.chamber_log, r.temperatures
+    if chamber is not None:  # the chamber column comes from the log, joined below
+        rest = tuple(c for c in asked or () if c != CHAMBER_COLUMN)
+        r = r.replace(chamber_log=None, temperatures=rest or (None if asked else asked))
     obj, info = open_table(p, r)
     stated, fitted = _stated_by_model(model)
     units_of = units.UnitOptions(  # the options' own; a rate's counter is in s (below)
@@ -644,6 +648,10 @@ def read_recording(
         from thermocal.models.rundata import check_sensor_id
 
         check_sensor_id(fitted, rec.meta.sensor_id, str(p))
+    if chamber is not None:
+        from thermocal.readers.chamber_log import join_chamber_log
+
+        return join_chamber_log(rec, chamber, asked)
     return rec
 
 
