@@ -556,7 +556,7 @@ def join_chamber_log(
     out = rec.with_columns({CHAMBER_COLUMN: values}, {CHAMBER_COLUMN: "degC"})
     extra = dict(rec.meta.extra)
     extra["chamber_log"] = {
-        "file": log.source, "channel": log.channel, "unit": log.unit,
+        "log": log.source, "channel": log.channel, "unit": log.unit,
         "unit_source": log.unit_source, "setpoint": log.setpoint, **join.to_dict(),
     }  # fmt: skip
     temps = rec.temperatures if temperatures is None else temperatures
