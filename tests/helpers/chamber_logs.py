@@ -33,7 +33,7 @@ def from_c(unit: str) -> Callable[[npt.NDArray[np.float64]], npt.NDArray[np.floa
 
 def clock_text(seconds: float, style: str) -> str:
     """A time of day as a chamber writes it: ``hh:mm``, ``hh:mm:ss`` or 12 h ``h:mm:ss AM``."""
-    s = int(round(seconds)) % 86400
+    s = round(seconds) % 86400
     h, m, sec = s // 3600, (s % 3600) // 60, s % 60
     if style == "hh:mm":
         return f"{h:02d}:{m:02d}"

@@ -9,8 +9,8 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from chamber_logs import air_c, write_log
 
+from chamber_logs import air_c, write_log
 from thermocal.errors import ThermocalInputError
 from thermocal.readers.chamber_log import parse_chamber_log, read_chamber_log
 from thermocal.readers.options import ChamberLogSpec

@@ -9,8 +9,8 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from chamber_logs import KNOTS_C, KNOTS_S, write_log, write_recording
 
+from chamber_logs import KNOTS_C, KNOTS_S, write_log, write_recording
 from thermocal.errors import ThermocalInputError, TimestampWarning
 from thermocal.readers import ReadOptions, read_recording
 from thermocal.readers.options import ChamberLogSpec
