@@ -302,13 +302,13 @@ def _wrapped_days(secs: list[float], dated: bool, where: str) -> list[int]:
 
 def _channels(table: _Table, skip: set[int]) -> dict[str, int]:
     """Numeric channels (name → column): every column but the clock's and date's whose
-    first data rows are numbers."""
+    first data rows are mostly numbers (a stray text cell is then refused, its line named)."""
     out: dict[str, int] = {}
     for i, name in enumerate(table.header):
         if i in skip or not name:
             continue
         cells = [f[i] for _, f in table.rows[:20] if i < len(f) and f[i]]
-        if cells and all(_number(c) is not None for c in cells):
+        if sum(_number(c) is not None for c in cells) > len(cells) / 2:
             out[name] = i
     return out
 
