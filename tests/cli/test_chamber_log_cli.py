@@ -10,8 +10,8 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from chamber_logs import air_c, write_log, write_recording
 
+from chamber_logs import air_c, write_log, write_recording
 from thermocal.cli import main
 
 UNITS = ("--time-unit", "s", "--signal-unit", "deg/h", "--temp-unit", "degC")

@@ -7,8 +7,8 @@ import hashlib
 from pathlib import Path
 
 import pytest
-from chamber_logs import write_recording
 
+from chamber_logs import write_recording
 from thermocal.cli import main
 
 HOSTILE: dict[str, tuple[bytes, str]] = {
