@@ -4237,6 +4237,22 @@ MUTANTS: tuple[Mutant, ...] = (
         _t("chamber_log_attacks", "chamber_log_cli"),
         "--chamber-log taken by the commands and then ignored",
     ),
+    Mutant(
+        "chamber-join-log-rounding",
+        P + "chamber_join.py",
+        "    var = q**2 / 12.0 + curve**2",
+        "    var = curve**2",
+        _t("chamber_join"),
+        "the log's rounding (q²/12 a reading) left out of the offset's and drift's σ",
+    ),
+    Mutant(
+        "chamber-join-log-corners",
+        P + "chamber_join.py",
+        "    var = q**2 / 12.0 + curve**2",
+        "    var = q**2 / 12.0 + 0.0 * curve",
+        _t("chamber_join"),
+        "the corners a coarse log's interpolation cuts left out of the σ",
+    ),
 )
 
 

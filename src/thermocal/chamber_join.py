@@ -24,7 +24,9 @@ The offset comes from one of three places (:attr:`ClockJoin.method`):
   by Gauss-Newton gives :math:`o` and :math:`\\delta` with their standard uncertainties
   :math:`\\sigma^2 = s^2 (J^\\top J)^{-1}` (Seber & Wild 1989, §2.1), :math:`s^2` inflated by
   :math:`(1 + \\rho)/(1 - \\rho)` for the residuals' lag-one autocorrelation :math:`\\rho`
-  (the effective number of samples, Bretherton et al. 1999).  The offset found includes the
+  (the effective number of samples, Bretherton et al. 1999), plus the log's own rounding
+  (:func:`log_resolution`: a uniform error of variance :math:`q^2/12` per reading, Widrow &
+  Kollár 2008, carried through the interpolation).  The offset found includes the
   sensor's thermal lag behind the chamber air: the recording's temperature follows the
   air late, so the log seems late by that lag.
 
@@ -262,6 +264,49 @@ def _gauss_newton(
     return np.asarray(p, dtype=np.float64), cov, np.asarray(res, dtype=np.float64)
 
 
+def log_resolution(values: npt.ArrayLike) -> float:
+    """The step of a log's readings: the smallest difference between two distinct values
+    (a log written to 0.1 °F reads in steps of 0.0556 °C).
+
+    Parameters
+    ----------
+    values : array_like
+        The log's temperatures [°C].
+
+    Returns
+    -------
+    float
+        The step [°C]; 0 with fewer than two distinct values.
+    """
+    v = np.unique(np.asarray(values, dtype=np.float64))
+    d = np.diff(v)
+    d = d[d > 1e-9 * max(1.0, float(np.max(np.abs(v))) if v.size else 1.0)]
+    return float(d.min()) if d.size else 0.0
+
+
+def _log_resolution_cov(u: FloatArray, lt: FloatArray, lv: FloatArray, p: FloatArray) -> FloatArray:
+    """The parameters' covariance from the log's own rounding: each log reading off by a
+    uniform error of variance :math:`q^2/12` (Widrow & Kollár 2008, ch. 4), spread over the
+    recording's samples by the interpolation weights :math:`W`:
+    :math:`b^2 \\frac{q^2}{12} M^{-1} (W^\\top J)^\\top (W^\\top J) M^{-1}`,
+    :math:`M = J^\\top J` (the sandwich form of a regressor's error)."""
+    q = log_resolution(lv)
+    tau = p[2] + (1.0 + p[3]) * u
+    val, slope = _interp_slope(tau, lt, lv)
+    jac = np.column_stack([np.ones_like(u), val, p[1] * slope, p[1] * slope * u])
+    k = np.clip(np.searchsorted(lt, tau, side="right") - 1, 0, lt.size - 2)
+    w = np.clip((tau - lt[k]) / (lt[k + 1] - lt[k]), 0.0, 1.0)
+    spread = np.zeros((lt.size, 4))
+    np.add.at(spread, k, (1.0 - w)[:, None] * jac)
+    np.add.at(spread, k + 1, w[:, None] * jac)
+    curve = np.zeros(lt.size)  # a corner between two readings: cut by up to |Δ²L|/8
+    curve[1:-1] = np.diff(lv, 2) / 8.0
+    var = q**2 / 12.0 + curve**2
+    m_inv = np.linalg.pinv(jac.T @ jac)
+    out = p[1] ** 2 * (m_inv @ (spread.T @ (var[:, None] * spread)) @ m_inv)
+    return np.asarray(out, dtype=np.float64)
+
+
 def _correlated(
     t: FloatArray, y: FloatArray, lt: FloatArray, lv: FloatArray
 ) -> tuple[float, float, float, float, float]:
@@ -283,6 +328,7 @@ def _correlated(
         )
     uf, yf = _thinned(u, y, MAX_FIT_POINTS)
     p, cov, _res = _gauss_newton(uf, yf, lt, lv, o0)
+    cov = cov + _log_resolution_cov(uf, lt, lv, p)
     x = np.interp(p[2] + (1.0 + p[3]) * uf, lt, lv)
     r = float(np.corrcoef(x, yf)[0, 1])
     return (

@@ -116,3 +116,27 @@ def test_time_zones() -> None:
     for bad in ("5", "+15:00", "+02:75", "CET"):
         with pytest.raises(ThermocalInputError, match="chamber_tz"):
             timezone_seconds(bad)
+
+
+def test_a_coarse_log_s_rounding_is_in_the_sigma() -> None:
+    # a log of one row a minute to 0.1 °F: its rounding (0.056 °C, q²/12 a reading) moves
+    # the offset and drift more than the sensor's noise does; each seed a chamber program of
+    # its own (other roundings), a recording 1.5 °C warm of the air
+    z_offset, z_drift = [], []
+    for seed in range(12):
+        rng = np.random.default_rng(100 + seed)
+        knots_s = np.array([0, 1800, 5400, 9000, 12600, 16200, 21600]) + rng.uniform(-200, 200, 7)
+        knots_s[0] = 0.0
+        knots_c = np.array([25, 25, 70, 70, -15, -15, 25]) + rng.uniform(-3, 3, 7)
+        lt = np.arange(0.0, 21600.0, 60.0)
+        lv = (np.round(np.interp(lt, knots_s, knots_c) * 1.8 + 32.0, 1) - 32.0) / 1.8
+        offset = 1820.0 + rng.uniform(-30.0, 30.0)
+        t = np.arange(0.0, 18000.0)
+        y = np.interp(offset + t, knots_s, knots_c) + 1.5 + 0.05 * rng.standard_normal(t.size)
+        j = join_clock(t, lt, lv, rec_temp_c=y)
+        assert j.offset_sigma_s is not None and j.drift_sigma_ppm is not None
+        z_offset.append((j.offset_s - offset) / j.offset_sigma_s)
+        z_drift.append(j.drift_ppm / j.drift_sigma_ppm)
+    for z in (np.array(z_offset), np.array(z_drift)):
+        assert 0.6 < float(np.sqrt(np.mean(z**2))) < 1.5
+        assert float(np.max(np.abs(z))) < 3.5
