@@ -363,12 +363,14 @@ O = TypeVar("O", FitOptions, ValidateOptions)
 def option_kinds(cls: type[Any]) -> dict[str, str]:
     """``{option name: "flag" | "int" | "float" | "str" | "path"}`` of an options dataclass
     (option names with dashes)."""
+    from thermocal.readers.options import ChamberLogSpec
     from thermocal.units import TemperatureConversion
 
-    hints = typing.get_type_hints(cls, localns={"TemperatureConversion": TemperatureConversion})
+    local = {"TemperatureConversion": TemperatureConversion, "ChamberLogSpec": ChamberLogSpec}
+    hints = typing.get_type_hints(cls, localns=local)
     out: dict[str, str] = {}
     for f in dataclasses.fields(cls):
-        if f.name == "params":  # the family's options: :func:`family_option_kinds`
+        if f.name in ("params", "chamber_log"):  # the family's options, a command line's log
             continue
         args = set(typing.get_args(hints[f.name])) - {type(None)} or {hints[f.name]}
         kind = next(iter(args))
