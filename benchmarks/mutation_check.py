@@ -4234,7 +4234,7 @@ MUTANTS: tuple[Mutant, ...] = (
         P + "cli/common.py",
         "    return r if spec is None else r.replace(chamber_log=spec)",
         "    return r",
-        _t("chamber_log_attacks", "chamber_log_cli"),
+        _t("chamber_log_attacks", "chamber_log_cli", "tutorial_chamber_log"),
         "--chamber-log taken by the commands and then ignored",
     ),
     Mutant(
