@@ -112,3 +112,28 @@ def test_profile_correlate_two_chamber_logs(
     assert same["column_b"] == "TC1 [°C]"
     mirrored = _json(capsys, "profile", "correlate", str(a), f"{b}:TC2", "--chamber-logs")
     assert mirrored["r"] == pytest.approx(-1.0, abs=1e-6)
+
+
+RECORDING_COMMANDS = (
+    "inspect", "fit", "validate", "allan", "metrics", "noise", "report", "ratetable",
+    "turntable", "multipos", "profile join",
+)  # fmt: skip
+"""The commands that read a sensor's recording and take its chamber log (compensate, which
+streams its file in chunks, takes the recording ``profile join -o`` writes)."""
+
+
+def test_every_recording_command_takes_the_same_options() -> None:
+    import typer
+
+    import thermocal.cli
+
+    thermocal.cli._register()
+    root = typer.main.get_command(thermocal.cli.app)
+    want = {"--chamber-log", "--chamber-unit", "--chamber-date", "--chamber-date-order",
+            "--chamber-offset", "--chamber-drift", "--chamber-tz"}  # fmt: skip
+    for name in RECORDING_COMMANDS:
+        command = root
+        for part in name.split():
+            command = command.commands[part]  # type: ignore[attr-defined]
+        opts = {o for p in command.params for o in p.opts}
+        assert want <= opts, (name, want - opts)

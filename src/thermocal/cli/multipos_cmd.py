@@ -25,6 +25,7 @@ from thermocal.cli.common import (
     TimeOpt,
     TimeUnitOpt,
     TriadAccelUnitOpt,
+    chamber_log_options,
     emit,
     handle_errors,
     read_options,
@@ -173,6 +174,7 @@ GyroModelOpt = Annotated[
 
 @app.command("multipos")
 @handle_errors
+@chamber_log_options
 def multipos_cmd(
     files: MultiposFilesArg,
     output: OutOpt,
