@@ -137,3 +137,19 @@ def test_every_recording_command_takes_the_same_options() -> None:
             command = command.commands[part]  # type: ignore[attr-defined]
         opts = {o for p in command.params for o in p.opts}
         assert want <= opts, (name, want - opts)
+
+
+def test_a_record_streamed_window_by_window_refuses_the_log(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    import pandas as pd
+
+    log, rec, _ = _files(tmp_path)
+    parquet = tmp_path / "rec.parquet"
+    pd.read_csv(rec).to_parquet(parquet)
+    for command in ("allan", "metrics"):
+        code = main([command, str(parquet), "--signal", "gx", *UNITS, "--stream",
+                     "--chamber-log", str(log), "--chamber-offset", "1234"])  # fmt: skip
+        err = capsys.readouterr().err.splitlines()
+        assert code == 2 and len(err) == 1, err
+        assert "read without a chamber log; drop --chamber-log" in err[0]
