@@ -23,6 +23,7 @@ from typing import Any
 
 import pytest
 
+from chamber_logs import write_log, write_recording
 from thermocal.cli import main
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -186,6 +187,10 @@ def _chamber_runs(t: Path) -> list[tuple[str, Any]]:
         ("compensate", _run(["compensate", model, val, "-o", str(t / "comp.csv")])),
         ("export-c", _run(["export-c", model, "-o", str(t / "c"), "--unit", "deg/h"])),
         ("profile correlate", _run(["profile", "correlate", mod, val])),
+        ("profile join", _run(["profile", "join", str(write_recording(t / "imu.csv",
+          offset_s=20.0, span_s=3000.0)[0]), "--temps", "T", "--time-unit", "s",
+          "--temp-unit", "degC", "--chamber-log", str(write_log(t / "chamber.csv",
+          span_s=6000.0)), "-o", str(t / "joined.csv")])),
         ("profile design-validation",
          _run(["profile", "design-validation", mod, "-o", str(t / "design.csv")])),
     ]  # fmt: skip

@@ -37,6 +37,7 @@ def multipos_page(tmp_path_factory: pytest.TempPathFactory) -> list[tuple[str, s
 
 def test_every_tutorial_is_executed_here() -> None:
     assert sorted(p.name for p in TUTORIALS.glob("*.md")) == [
+        "chamber-log.md",  # tests/docs/test_tutorial_chamber_log.py
         "chamber-to-c.md",  # tests/docs/test_tutorials_a.py
         "fc-params.md",  # tests/docs/test_tutorials_b.py
         "firmware-learning.md",  # tests/docs/test_tutorial_firmware_learning.py

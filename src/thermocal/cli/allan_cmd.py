@@ -29,6 +29,7 @@ from thermocal.cli.common import (
     TimeOpt,
     TimeUnitOpt,
     TopicOpt,
+    chamber_log_options,
     check_recording,
     emit,
     handle_errors,
@@ -267,6 +268,7 @@ def _write_plots(file: Path, plot: Path, res: "_analysis.AllanAnalysis") -> None
 
 @app.command("allan")
 @handle_errors
+@chamber_log_options
 def allan_cmd(
     file: FileArg,
     signal: SignalOpt = None,

@@ -11,7 +11,9 @@ The common rules of the command line, implemented here:
 
 from __future__ import annotations
 
+import contextvars
 import functools
+import inspect
 import json
 import os
 import sys
@@ -31,7 +33,7 @@ from thermocal.pipeline.messages import error_text, warning_lines
 from thermocal.pipeline.messages import jsonable as jsonable
 from thermocal.pipeline.messages import one_line as one_line
 from thermocal.pipeline.reading import check_recording as check_recording
-from thermocal.pipeline.reading import read_options as read_options
+from thermocal.pipeline.reading import read_options as _read_options
 from thermocal.pipeline.reading import split_names as split_names
 from thermocal.report.text import Block
 
@@ -40,6 +42,7 @@ if TYPE_CHECKING:
     from rich.console import Console
 
     from thermocal import units
+    from thermocal.readers.options import ChamberLogSpec, ReadOptions
 else:
     # this module is imported to register commands (``--help``): nothing heavy at import
     np = LazyModule("numpy")
@@ -488,3 +491,169 @@ HeaterMinHoldOpt = Annotated[
     float,
     typer.Option("--heater-min-hold", help="Shortest heater hold [s] (default 60)."),
 ]
+
+
+# --- a chamber's own log, joined by time (every recording command) --------------------------
+
+ChamberLogOpt = Annotated[
+    str | None,
+    typer.Option(
+        "--chamber-log",
+        help="The chamber's or data logger's own log (CSV/TSV with an hh:mm[:ss] clock), "
+        "FILE or FILE:CHANNEL: its channel joined by time to the recording as the temperature "
+        "column 'chamber' (--temps T,chamber; --ambient chamber). The clocks' offset is "
+        "--chamber-offset, or from absolute times (--chamber-tz), or found by correlating the "
+        "recording's own temperature (offset and drift stated in a warning).",
+    ),
+]
+ChamberUnitOpt = Annotated[
+    str | None,
+    typer.Option("--chamber-unit", help="The chamber log's unit: degF, degC or K (default: "
+                 "its header)."),
+]  # fmt: skip
+ChamberDateOpt = Annotated[
+    str | None,
+    typer.Option("--chamber-date", help="The chamber log's first date, YYYY-MM-DD (a log with "
+                 "no dates whose clock passes midnight)."),
+]  # fmt: skip
+ChamberDateOrderOpt = Annotated[
+    str | None,
+    typer.Option("--chamber-date-order", help="How the chamber log's dates read: dmy "
+                 "(03/04 is 3 April) or mdy (4 March)."),
+]  # fmt: skip
+ChamberOffsetOpt = Annotated[
+    float | None,
+    typer.Option("--chamber-offset", help="Where the recording's first sample falls on the "
+                 "chamber log's clock [s], counted from the log's first row."),
+]  # fmt: skip
+ChamberDriftOpt = Annotated[
+    float | None,
+    typer.Option("--chamber-drift", help="The chamber log clock's gain on the recording's "
+                 "[ppm], with --chamber-offset (default 0)."),
+]  # fmt: skip
+ChamberTzOpt = Annotated[
+    str | None,
+    typer.Option("--chamber-tz", help="The chamber log's time zone, +HH:MM from UTC, when the "
+                 "recording's time is absolute (UTC)."),
+]  # fmt: skip
+
+_CHAMBER_OPTIONS: tuple[tuple[str, Any], ...] = (
+    ("chamber_log", ChamberLogOpt), ("chamber_unit", ChamberUnitOpt),
+    ("chamber_date", ChamberDateOpt), ("chamber_date_order", ChamberDateOrderOpt),
+    ("chamber_offset", ChamberOffsetOpt), ("chamber_drift", ChamberDriftOpt),
+    ("chamber_tz", ChamberTzOpt),
+)  # fmt: skip
+"""The chamber-log options every recording command takes (:func:`chamber_log_options`)."""
+
+_CHAMBER: contextvars.ContextVar[ChamberLogSpec | None] = contextvars.ContextVar(
+    "chamber_log", default=None
+)
+
+
+def chamber_spec(given: dict[str, Any]) -> ChamberLogSpec | None:
+    """The :class:`~thermocal.readers.options.ChamberLogSpec` of the chamber-log options
+    (None without ``--chamber-log``; the others alone are refused).
+
+    Parameters
+    ----------
+    given : dict
+        ``chamber_log``, ``chamber_unit``, … as typed.
+
+    Returns
+    -------
+    ChamberLogSpec or None
+
+    Raises
+    ------
+    ThermocalInputError
+        A chamber option without ``--chamber-log``.
+    """
+    from thermocal.readers.options import ChamberLogSpec
+
+    text = given.get("chamber_log")
+    if text is None:
+        others = [n for n, v in given.items() if v is not None]
+        if others:
+            raise ThermocalInputError(
+                f"--{others[0].replace('_', '-')} applies with --chamber-log FILE[:CHANNEL]"
+            )
+        return None
+    if given.get("chamber_drift") is not None and given.get("chamber_offset") is None:
+        raise ThermocalInputError(
+            "--chamber-drift applies with --chamber-offset (found by correlation, the drift "
+            "is estimated)"
+        )
+    return ChamberLogSpec.parse(
+        text, unit=given.get("chamber_unit"), date=given.get("chamber_date"),
+        date_order=given.get("chamber_date_order"), offset_s=given.get("chamber_offset"),
+        drift_ppm=given.get("chamber_drift"), tz=given.get("chamber_tz"),
+    )  # fmt: skip
+
+
+def chamber_log_options(fn: Callable[P, R]) -> Callable[P, R]:
+    """Give a command the chamber-log options (``--chamber-log FILE[:CHANNEL]`` and
+    ``--chamber-unit``, ``--chamber-date``, ``--chamber-date-order``, ``--chamber-offset``,
+    ``--chamber-drift``, ``--chamber-tz``): they are added to its signature, taken off its
+    arguments and, while it runs, put into every :func:`read_options` it builds
+    (:func:`current_chamber_log` for options objects built otherwise).
+
+    Parameters
+    ----------
+    fn : callable
+        The command's function (below :func:`handle_errors`).
+
+    Returns
+    -------
+    callable
+        The command with the options.
+    """
+    sig = inspect.signature(fn, eval_str=True)
+    extra = [
+        inspect.Parameter(n, inspect.Parameter.KEYWORD_ONLY, annotation=a, default=None)
+        for n, a in _CHAMBER_OPTIONS
+    ]
+    kept = [p for p in sig.parameters.values() if p.kind != inspect.Parameter.VAR_KEYWORD]
+
+    @functools.wraps(fn)
+    def wrapper(*args: P.args, **kwargs: P.kwargs) -> R:
+        given = {n: kwargs.pop(n, None) for n, _ in _CHAMBER_OPTIONS}
+        token = _CHAMBER.set(chamber_spec(given))
+        try:
+            return fn(*args, **kwargs)
+        finally:
+            _CHAMBER.reset(token)
+
+    wrapper.__signature__ = sig.replace(parameters=[*kept, *extra])  # type: ignore[attr-defined]
+    wrapper.__annotations__ = {
+        **{p.name: p.annotation for p in kept},
+        **{n: a for n, a in _CHAMBER_OPTIONS},
+    }
+    return wrapper
+
+
+def current_chamber_log() -> ChamberLogSpec | None:
+    """The chamber log of the command running (:func:`chamber_log_options`), or None.
+
+    Returns
+    -------
+    ChamberLogSpec or None
+    """
+    return _CHAMBER.get()
+
+
+def read_options(**given: Any) -> ReadOptions:
+    """:func:`thermocal.pipeline.reading.read_options` with the running command's chamber
+    log (:func:`chamber_log_options`).
+
+    Parameters
+    ----------
+    **given
+        As :func:`thermocal.pipeline.reading.read_options` takes them.
+
+    Returns
+    -------
+    ReadOptions
+    """
+    r = _read_options(**given)
+    spec = _CHAMBER.get()
+    return r if spec is None else r.replace(chamber_log=spec)

@@ -62,6 +62,8 @@ from thermocal.cli.common import (
     TimeOpt,
     TimeUnitOpt,
     TopicOpt,
+    chamber_log_options,
+    current_chamber_log,
     emit,
     handle_errors,
     split_floats,
@@ -271,7 +273,7 @@ def fit_cmd(**values: Any) -> None:
     texts = values.pop("param") or []
     _check_switches(values)
     values = _family_values(values)
-    options = options_of(FitOptions, values)
+    options = options_of(FitOptions, {**values, "chamber_log": current_chamber_log()})
     params = family_params(values)
     params |= _param_values(options.model, texts, params)
     options = dataclasses.replace(options, params=params)
@@ -322,7 +324,7 @@ fit_cmd.__signature__ = inspect.Signature(  # type: ignore[attr-defined]
     + _family_parameters()
     + [inspect.Parameter(n, KW, annotation=a, default=d) for n, a, d in _COMMON_LAST]
 )
-app.command("fit")(handle_errors(fit_cmd))
+app.command("fit")(handle_errors(chamber_log_options(fit_cmd)))
 
 
 def _human_single(

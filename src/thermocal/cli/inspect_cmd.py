@@ -22,6 +22,7 @@ from thermocal.cli.common import (
     TimeOpt,
     TimeUnitOpt,
     TopicOpt,
+    chamber_log_options,
     emit,
     handle_errors,
     one_line,
@@ -48,6 +49,7 @@ else:
 
 @app.command("inspect")
 @handle_errors
+@chamber_log_options
 def inspect_cmd(
     file: FileArg,
     time: TimeOpt = None,

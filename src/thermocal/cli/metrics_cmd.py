@@ -26,6 +26,7 @@ from thermocal.cli.common import (
     TimeOpt,
     TimeUnitOpt,
     TopicOpt,
+    chamber_log_options,
     check_recording,
     emit,
     handle_errors,
@@ -98,6 +99,7 @@ StreamOpt = Annotated[
 
 @app.command("metrics")
 @handle_errors
+@chamber_log_options
 def metrics_cmd(
     files: MetricsFilesArg,
     signal: SignalOpt = None,

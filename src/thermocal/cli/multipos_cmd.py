@@ -25,6 +25,7 @@ from thermocal.cli.common import (
     TimeOpt,
     TimeUnitOpt,
     TriadAccelUnitOpt,
+    chamber_log_options,
     emit,
     handle_errors,
     read_options,
@@ -183,6 +184,7 @@ GSensitivityOpt = Annotated[
 
 @app.command("multipos")
 @handle_errors
+@chamber_log_options
 def multipos_cmd(
     files: MultiposFilesArg,
     output: OutOpt,

@@ -25,6 +25,7 @@ from thermocal.cli.common import (
     TimeOpt,
     TimeUnitOpt,
     TopicOpt,
+    chamber_log_options,
     check_recording,
     handle_errors,
     jsonable,
@@ -181,6 +182,7 @@ def _check_temps_options(
 
 @app.command("noise")
 @handle_errors
+@chamber_log_options
 def noise_cmd(
     file: FileArg,
     output: NoiseOutOpt,

@@ -5,6 +5,9 @@
   ``accel-full-range``) writes the chamber program ``time_s, setpoint_c``.
 * ``thermocal profile correlate A B [--column C] [--json]``: r and
   ``weakly_correlated`` of two temperature histories (r < 0.4).
+* ``thermocal profile join FILE --chamber-log LOG[:CHANNEL] [-o OUT]``: a chamber's own
+  log joined by time to a recording (offset, drift, time zone stated; OUT the recording with
+  the column ``chamber``).  ``profile correlate A B --chamber-logs`` correlates two such logs.
 * ``thermocal profile design-validation MODEL -o VAL.csv --seed N``, or
   ``thermocal profile rlg-validation --against MODEL --seed N``: a hold profile
   over the modelling range with |r| below the limit.
@@ -20,6 +23,9 @@ from thermocal import defaults
 from thermocal._lazy import LazyModule
 from thermocal.cli.application import app
 from thermocal.cli.common import (
+    ChamberDateOpt,
+    ChamberDateOrderOpt,
+    ChamberUnitOpt,
     DecimalOpt,
     DelimiterOpt,
     JsonOpt,
@@ -27,7 +33,13 @@ from thermocal.cli.common import (
     OnBadLinesOpt,
     OutOpt,
     StampOpt,
+    TempsOpt,
+    TempUnitOpt,
+    TimeOpt,
+    TimeUnitOpt,
     TopicOpt,
+    chamber_log_options,
+    current_chamber_log,
     emit,
     handle_errors,
     read_options,
@@ -309,20 +321,36 @@ def correlate_cmd(
     t_bad: OnBadLinesOpt = "error",
     t_delim: DelimiterOpt = None,
     t_dec: DecimalOpt = None,
+    chamber_logs: Annotated[
+        bool,
+        typer.Option(
+            "--chamber-logs",
+            help="A and B are chamber or logger logs (hh:mm[:ss] clocks), FILE or "
+            "FILE:CHANNEL; their clocks' elapsed time is the base.",
+        ),
+    ] = False,
+    chamber_unit: ChamberUnitOpt = None,
+    chamber_date: ChamberDateOpt = None,
+    chamber_date_order: ChamberDateOrderOpt = None,
     as_json: JsonOpt = False,
 ) -> None:
     """r = Cov(X, Y)/(σX σY) of two temperature histories on a common elapsed-time base."""
-    read = read_options(
-        topic=topic,
-        names=t_names,
-        rate=t_rate,
-        on_bad_lines=t_bad,
-        delimiter=t_delim,
-        decimal=t_dec,
-        stamp=stamp,
-    )
-    ta, xa, ca = _program.read_history(file_a, column, read)
-    tb, xb, cb = _program.read_history(file_b, column_b if column_b is not None else column, read)
+    if chamber_logs:
+        given = {"chamber_unit": chamber_unit, "chamber_date": chamber_date,
+                 "chamber_date_order": chamber_date_order}  # fmt: skip
+        ta, xa, ca = _chamber_history(file_a, given)
+        tb, xb, cb = _chamber_history(file_b, given)
+    else:
+        if chamber_unit or chamber_date or chamber_date_order:
+            raise ThermocalInputError(
+                "--chamber-unit, --chamber-date and --chamber-date-order apply with --chamber-logs"
+            )
+        ta, xa, ca, tb, xb, cb = _histories(
+            file_a, file_b, column, column_b, read_options(
+                topic=topic, names=t_names, rate=t_rate, on_bad_lines=t_bad,
+                delimiter=t_delim, decimal=t_dec, stamp=stamp,
+            ),
+        )  # fmt: skip
     res = _profiles.correlate(ta, xa, tb, xb, r_limit=limit, n_points=points)
     emit(
         {**res.to_dict(), "column_a": ca, "column_b": cb},
@@ -333,6 +361,26 @@ def correlate_cmd(
             + f" (limit {limit:g})"
         ),
     )
+
+
+def _chamber_history(path: Path, given: dict[str, Any]) -> tuple["np.ndarray", "np.ndarray", str]:
+    """A chamber log's channel: its clock [s] from its first row, °C and name."""
+    from thermocal.cli.common import chamber_spec
+    from thermocal.readers.chamber_log import read_chamber_log
+
+    spec = chamber_spec({"chamber_log": str(path), **given})
+    assert spec is not None  # --chamber-log given
+    log = read_chamber_log(spec)
+    return log.time_s, log.temp_c, log.channel
+
+
+def _histories(
+    file_a: Path, file_b: Path, column: str | None, column_b: str | None, read: Any
+) -> tuple[Any, ...]:
+    """The two temperature histories of programs or recordings (``--column``, ``--column-b``)."""
+    ta, xa, ca = _program.read_history(file_a, column, read)
+    tb, xb, cb = _program.read_history(file_b, column_b if column_b is not None else column, read)
+    return ta, xa, ca, tb, xb, cb
 
 
 def _design(
@@ -372,3 +420,52 @@ def design_validation_cmd(
     """A hold profile over the modelling range, weakly correlated with it (seeded)."""
     _writers.check_not_input(output, [model])
     _design(model, output, column, seed, limit, n_holds, hold_s, rate, dt, as_json)
+
+
+@profile_app.command("join")
+@handle_errors
+@chamber_log_options
+def join_cmd(
+    file: Annotated[Path, typer.Argument(help="The sensor's recording.", show_default=False)],
+    temps: TempsOpt = None,
+    time: TimeOpt = None,
+    time_unit: TimeUnitOpt = None,
+    temp_unit: TempUnitOpt = None,
+    output: Annotated[
+        Path | None,
+        typer.Option(
+            "-o", "--output", help="The recording with the joined column 'chamber' (CSV, Parquet)."
+        ),
+    ] = None,
+    as_json: JsonOpt = False,
+) -> None:
+    """A chamber's own log (--chamber-log) joined by time to a recording: the clocks' offset,
+    drift and time zone, with their uncertainties; -o writes the joined recording."""
+    spec = current_chamber_log()
+    if spec is None:
+        raise ThermocalInputError("profile join: give the log, --chamber-log FILE[:CHANNEL]")
+    inputs: list[str | Path] = [file, spec.path]
+    if output is not None:
+        _writers.check_not_input(output, inputs)
+    read = read_options(time=time, time_unit=time_unit, temps=temps, temp_unit=temp_unit)
+    rec = _readers.read_recording(file, read)
+    joined = dict(rec.meta.extra["chamber_log"])
+    if output is not None:
+        _writers.write_recording(rec, output)
+    out = {"file": str(file), "column": "chamber", **joined, "output": output}
+    emit(out, as_json, lambda: _show_join(out))
+
+
+def _show_join(out: dict[str, Any]) -> None:
+    """The join as lines of text."""
+    sig_o, sig_d = out["offset_sigma_s"], out["drift_sigma_ppm"]
+    pm_o = f" ± {sig_o:.2g}" if sig_o is not None else " (given)"
+    pm_d = f" ± {sig_d:.2g}" if sig_d is not None else " (assumed)"
+    stdout.print(f"{out['log']} [{out['channel']}, {out['unit']}] → {out['file']}: {out['method']}")
+    stdout.print(f"offset {out['offset_s']:.6g}{pm_o} s, drift {out['drift_ppm']:.4g}{pm_d} ppm")
+    if out["timezone"]:
+        stdout.print(f"time zone {out['timezone']}")
+    if out["correlation"] is not None:
+        stdout.print(f"correlation r = {out['correlation']:.4f}")
+    if out["output"] is not None:
+        stdout.print(f"written: {out['output']}")

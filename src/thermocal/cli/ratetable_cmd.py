@@ -22,6 +22,7 @@ from thermocal.cli.common import (
     RateOpt,
     TimeOpt,
     TimeUnitOpt,
+    chamber_log_options,
     emit,
     handle_errors,
     read_options,
@@ -127,6 +128,7 @@ ResultOpt = Annotated[
 
 @app.command("ratetable")
 @handle_errors
+@chamber_log_options
 def ratetable_cmd(
     files: FilesArg,
     gyro: GyroOpt = "gyro",

@@ -30,6 +30,7 @@ from thermocal.cli.common import (
     TimeOpt,
     TimeUnitOpt,
     TurntableLatitudeOpt,
+    chamber_log_options,
     handle_errors,
     progress,
     read_options,
@@ -44,6 +45,7 @@ else:
 
 @app.command("report")
 @handle_errors
+@chamber_log_options
 def report_cmd(
     model: Annotated[
         list[Path],

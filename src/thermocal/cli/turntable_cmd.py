@@ -28,6 +28,7 @@ from thermocal.cli.common import (
     TimeUnitOpt,
     TopicOpt,
     TriadAccelUnitOpt,
+    chamber_log_options,
     emit,
     handle_errors,
     read_options,
@@ -136,6 +137,7 @@ TrefOpt = Annotated[
 
 @app.command("turntable")
 @handle_errors
+@chamber_log_options
 def turntable_cmd(
     files: FilesArg,
     output: OutOpt,

@@ -40,6 +40,8 @@ from thermocal.cli.common import (
     TimeUnitOpt,
     TopicOpt,
     TurntableLatitudeOpt,
+    chamber_log_options,
+    current_chamber_log,
     emit,
     handle_errors,
     stdout,
@@ -190,6 +192,7 @@ def _human_triads(report: "_validate.ValidationReport") -> None:
 
 @app.command("validate")
 @handle_errors
+@chamber_log_options
 def validate_cmd(
     model_file: ModelArg,
     file: FileArg,
@@ -221,7 +224,8 @@ def validate_cmd(
     hold stages, rms and peak-to-peak, before and after compensation; a calibration of
     triads (thermocal turntable over temperature) on a turntable run: dwell-mean and
     move-angle errors before and after."""
-    report = _validate.validate_files(model_file, file, options_of(ValidateOptions, locals()))
+    given = {**locals(), "chamber_log": current_chamber_log()}
+    report = _validate.validate_files(model_file, file, options_of(ValidateOptions, given))
     if report.triads:
         emit(report.to_dict(), as_json, lambda: _human_triads(report))
     elif report.several:

@@ -217,6 +217,12 @@ def _plan(path: Path, read: ReadOptions, signal: str | None) -> _Plan:
             "column; drop {rate_hz}",
             "rate_hz",
         )
+    if read.chamber_log is not None:
+        raise ThermocalInputError.naming(
+            f"{path}: a record analysed window by window is read without a chamber log; drop "
+            "{chamber_log}, or join it first (thermocal profile join -o) and cut the record",
+            "chamber_log",
+        )
     obj, info = dispatch.open_table(path, read)
     pf = pq.ParquetFile(path)
     opts = UnitOptions(read.time_unit, read.signal_unit, read.temp_unit, read.temp_conversion)

@@ -26,7 +26,7 @@ from thermocal.families import FamilyOption, fit_option_table
 from thermocal.pipeline.messages import option_name
 
 if TYPE_CHECKING:  # numpy and the readers: imported when used (``fit --help`` loads neither)
-    from thermocal.readers.options import ReadOptions
+    from thermocal.readers.options import ChamberLogSpec, ReadOptions
     from thermocal.units import TemperatureConversion
 
 TARGETS = ("bias", "scale_factor")
@@ -98,6 +98,8 @@ class FitOptions:
     stamp : {"header", "receive"}
         Time of a ROS bag's messages: their header stamp (default) or the bag's receive
         time.
+    chamber_log : ChamberLogSpec, optional
+        A chamber's own log joined by time to each file (its column ``chamber``).
     heater : {"cut", "refuse", "ignore"}
         A heated sensor's hold at its set-point (:class:`thermocal.heater.HeaterPolicy`):
         thinned to the sweep's density with the cut range said (default), refused, or
@@ -156,6 +158,7 @@ class FitOptions:
     delimiter: str | None = None
     decimal: Literal[".", ","] | None = None
     stamp: Literal["header", "receive"] = "header"
+    chamber_log: ChamberLogSpec | None = None
     heater: Literal["cut", "refuse", "ignore"] = "cut"
     heater_setpoint: float | None = None
     heater_band: float = 0.5
@@ -252,6 +255,8 @@ class ValidateOptions:
     stamp : {"header", "receive"}
         Time of a ROS bag's messages: their header stamp (default) or the bag's receive
         time.
+    chamber_log : ChamberLogSpec, optional
+        A chamber's own log joined by time to each file (its column ``chamber``).
     latitude : float, optional
         Test-site latitude [°] of a turntable run judging a triad calibration.
     static_s : float
@@ -291,6 +296,7 @@ class ValidateOptions:
     decimal: Literal[".", ","] | None = None
     topic: str | None = None
     stamp: Literal["header", "receive"] = "header"
+    chamber_log: ChamberLogSpec | None = None
     latitude: float | None = None
     static_s: float = 1.0
 
@@ -334,7 +340,7 @@ def _read_options(
         temp_conversion=o.temp_conversion,
         topic=o.topic, names=o.names, rate_hz=o.rate_hz,
         on_bad_lines=o.on_bad_lines,
-        delimiter=o.delimiter, decimal=o.decimal, stamp=o.stamp,
+        delimiter=o.delimiter, decimal=o.decimal, stamp=o.stamp, chamber_log=o.chamber_log,
     )  # fmt: skip
     return ReadOptions(**given)
 
@@ -357,12 +363,14 @@ O = TypeVar("O", FitOptions, ValidateOptions)
 def option_kinds(cls: type[Any]) -> dict[str, str]:
     """``{option name: "flag" | "int" | "float" | "str" | "path"}`` of an options dataclass
     (option names with dashes)."""
+    from thermocal.readers.options import ChamberLogSpec
     from thermocal.units import TemperatureConversion
 
-    hints = typing.get_type_hints(cls, localns={"TemperatureConversion": TemperatureConversion})
+    local = {"TemperatureConversion": TemperatureConversion, "ChamberLogSpec": ChamberLogSpec}
+    hints = typing.get_type_hints(cls, localns=local)
     out: dict[str, str] = {}
     for f in dataclasses.fields(cls):
-        if f.name == "params":  # the family's options: :func:`family_option_kinds`
+        if f.name in ("params", "chamber_log"):  # the family's options, a command line's log
             continue
         args = set(typing.get_args(hints[f.name])) - {type(None)} or {hints[f.name]}
         kind = next(iter(args))

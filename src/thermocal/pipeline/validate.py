@@ -19,6 +19,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from thermocal.errors import (
+    CorrelationWarning,
     FileFormatError,
     ParameterError,
     ThermocalInputError,
@@ -28,6 +29,7 @@ from thermocal.errors import (
 from thermocal.pipeline.options import ValidateOptions
 from thermocal.pipeline.reading import check_recording
 from thermocal.readers.formats import file_kind, format_named
+from thermocal.readers.options import CHAMBER_COLUMN
 
 if TYPE_CHECKING:
     from thermocal.models.base import TemperatureModel
@@ -200,6 +202,17 @@ def _modeling_ambient(
             signals=None, temperatures=(amb,), signal_unit=None,
             topic=o.topic if _is_log(mod_path) else None,
         )  # fmt: skip
+        if read.chamber_log is not None and Path(mod_path) != Path(ctx.file):
+            if amb == CHAMBER_COLUMN:  # the chamber log is the validated run's, not this one's
+                warnings.warn(
+                    CorrelationWarning(
+                        f"{mod_path}: the modelling run has no chamber log: r of the ambient "
+                        "histories not computed"
+                    ),
+                    stacklevel=2,
+                )
+                return None, None
+            read = read.replace(chamber_log=None)
         mrec = read_recording(mod_path, read, model=model)
         for prob in recording.find_problems(mrec, required=[amb]):
             if prob.severity == "error" and (prob.column in (None, "time", amb)):

@@ -7,7 +7,7 @@ from __future__ import annotations
 import dataclasses
 import re
 import warnings
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, cast
 
@@ -30,7 +30,7 @@ from thermocal.readers.common import (
     short_name,
 )
 from thermocal.readers.formats import TEXT_FIELDS, FileFormat, format_of, registered_formats
-from thermocal.readers.options import ReadOptions
+from thermocal.readers.options import CHAMBER_COLUMN, ReadOptions
 from thermocal.readers.station import is_station_path
 from thermocal.readers.table import (
     ON_DEMAND_MIN_COLUMNS,
@@ -629,7 +629,7 @@ def read_recording(
     ([0.0, 0.01, 0.02], 'deg/s', [20.0, 20.5, 21.0])
     """
     p = Path(path)
-    r = read or ReadOptions()
+    r, joined = _chamber_apart(read or ReadOptions())  # the chamber's column: not in the file
     obj, info = open_table(p, r)
     stated, fitted = _stated_by_model(model)
     units_of = units.UnitOptions(  # the options' own; a rate's counter is in s (below)
@@ -644,7 +644,20 @@ def read_recording(
         from thermocal.models.rundata import check_sensor_id
 
         check_sensor_id(fitted, rec.meta.sensor_id, str(p))
-    return rec
+    return rec if joined is None else joined(rec)
+
+
+def _chamber_apart(r: ReadOptions) -> tuple[ReadOptions, Callable[[Recording], Recording] | None]:
+    """The options without the chamber log (its column taken off the temperatures: it is
+    not in the file) and what joins it to the recording read (None without a log)."""
+    chamber, asked = r.chamber_log, r.temperatures
+    if chamber is None:
+        return r, None
+    from thermocal.readers.chamber_log import join_chamber_log
+
+    rest = tuple(c for c in asked or () if c != CHAMBER_COLUMN)
+    r = r.replace(chamber_log=None, temperatures=rest or (None if asked else asked))
+    return r, lambda rec: join_chamber_log(rec, chamber, asked)
 
 
 def table_recording(

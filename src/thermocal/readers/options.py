@@ -48,6 +48,83 @@ def _units(value: Iterable[str]) -> tuple[str, ...]:
     return out
 
 
+CHAMBER_COLUMN = "chamber"
+"""The temperature column a chamber log adds to a recording (``--temps chamber``,
+``--ambient chamber``)."""
+
+
+@dataclass(frozen=True)
+class ChamberLogSpec:
+    """A chamber's or data logger's own log to join to a recording by time.
+
+    Parameters
+    ----------
+    path : str
+        The log file.
+    channel : str, optional
+        Its channel (``TC3``, ``Chamber PV``; default: the one process value).
+    unit : str, optional
+        The channels' unit (``degF``, ``degC``, ``K``; default: from the header).
+    date : str, optional
+        The first row's date (``YYYY-MM-DD``) of a log without dates.
+    date_order : {"dmy", "mdy"}, optional
+        How ``03/04/2026`` reads.
+    offset_s : float, optional
+        Where the recording's first sample falls on the log's clock [s], counted from the
+        log's first row (default: from absolute times, else by correlation).
+    drift_ppm : float, optional
+        The log clock's gain on the recording's [ppm] (with ``offset_s``; default 0).
+    tz : str, optional
+        The log's time zone (``+02:00``) when the recording's time is absolute (UTC).
+    """
+
+    path: str
+    channel: str | None = None
+    unit: str | None = None
+    date: str | None = None
+    date_order: Literal["dmy", "mdy"] | None = None
+    offset_s: float | None = None
+    drift_ppm: float | None = None
+    tz: str | None = None
+
+    def __post_init__(self) -> None:
+        if self.date_order not in (None, "dmy", "mdy"):
+            raise ParameterError(
+                "chamber_date_order", f"{{name}} must be dmy or mdy, got {self.date_order!r}"
+            )
+        for name in ("offset_s", "drift_ppm"):
+            v = getattr(self, name)
+            if v is not None and not math.isfinite(v):
+                raise ParameterError("chamber_" + name.split("_")[0], "{name} must be finite")
+
+    @classmethod
+    def parse(cls, text: str, **given: Any) -> ChamberLogSpec:
+        """``FILE`` or ``FILE:CHANNEL`` (a colon in an existing file's name stays in it).
+
+        Parameters
+        ----------
+        text : str
+            The option's text.
+        **given
+            The other fields.
+
+        Returns
+        -------
+        ChamberLogSpec
+
+        Examples
+        --------
+        >>> ChamberLogSpec.parse("log.csv:TC3").channel
+        'TC3'
+        """
+        import os
+
+        path, colon, channel = text.rpartition(":")
+        if not colon or os.path.exists(text) or not path or "/" in channel or "\\" in channel:
+            return cls(text, **given)
+        return cls(path, channel=channel.strip() or None, **given)
+
+
 @dataclass(frozen=True)
 class ReadOptions:
     """How to read a recording; every field left ``None`` is taken from the file.
@@ -90,6 +167,9 @@ class ReadOptions:
     stamp : {"header", "receive"}
         Time of a ROS bag's messages: their header stamp (default) or the bag's receive
         time.
+    chamber_log : ChamberLogSpec, optional
+        A chamber's own log joined by time: its channel becomes the temperature column
+        :data:`CHAMBER_COLUMN` (``temperatures`` may name it).
 
     Raises
     ------
@@ -121,6 +201,7 @@ class ReadOptions:
     delimiter: str | None = None
     decimal: Literal[".", ","] | None = None
     stamp: Literal["header", "receive"] = "header"
+    chamber_log: ChamberLogSpec | None = None
 
     def __post_init__(self) -> None:
         set_ = object.__setattr__  # frozen: normalise in place once
@@ -193,4 +274,4 @@ class ReadOptions:
         )
 
 
-__all__ = ["RATE_HZ_RANGE", "ReadOptions"]
+__all__ = ["CHAMBER_COLUMN", "RATE_HZ_RANGE", "ChamberLogSpec", "ReadOptions"]
