@@ -4244,6 +4244,8 @@ MUTANTS: tuple[Mutant, ...] = (
         "if sensed is not None and ver < COUNT_SCALE_FORMAT_VERSION:",
         _t("calibration_g_sensitivity"),
         "a version-2 file with a g-sensitivity read (an older thermocal would drop A)",
+    ),
+    Mutant(
         "chamber-log-fahrenheit-offset",
         P + "readers/chamber_log.py",
         '"degF": (5.0 / 9.0, -32.0 * 5.0 / 9.0),',
