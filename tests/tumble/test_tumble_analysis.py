@@ -58,7 +58,7 @@ def test_k2_and_kip_recovered_within_3_sigma_over_seeds() -> None:
 
 def test_continuous_tumble_and_third_harmonic() -> None:
     rec, truth = simulate_tumble(np.random.default_rng(5), turn_rate_dps=2.0, rate_hz=20.0,
-                                 k3=0.02)  # fmt: skip
+                                 k3=0.05)  # fmt: skip
     fit = fit_harmonics(rec.columns["angle"], rec.columns["accel"], harmonics=3)
     k = coefficients_from_harmonics(fit)
     for n in ("k0", "k1", "delta_o", "k2", "k_ip", "k3"):
@@ -92,3 +92,25 @@ def test_stations_found_with_settling_left_out() -> None:
                                 settle_s=2.0)  # fmt: skip
     assert [round(s.angle_deg, 6) for s in st] == truth["angles_deg"]
     assert all(s.n in (8 * 50, 8 * 50 + 1) for s in st) and dropped == []
+
+
+def test_station_means_scattering_beyond_their_noise_widen_the_sigma() -> None:
+    """Station means given a σ far below their scatter (the head's angle errors): the Birge
+    correction gives the σ the residuals say, as an unweighted fit's."""
+    st, _ = _stations(9)
+    th = [s.angle_deg for s in st]
+    y = np.array([s.mean for s in st]) + 0.01 * np.sin(np.arange(len(st)) * 2.3)
+    tiny = fit_harmonics(th, y, np.full(len(st), 1e-6))
+    plain = fit_harmonics(th, y)
+    assert tiny.reduced_chi2 is not None and tiny.reduced_chi2 > 1e6
+    np.testing.assert_allclose(tiny.sigma, plain.sigma, rtol=1e-9)
+
+
+def test_continuous_tumble_sigma_is_honest_over_seeds() -> None:
+    z = []
+    for seed in range(40):
+        rec, truth = simulate_tumble(np.random.default_rng(500 + seed), turn_rate_dps=4.0,
+                                     rate_hz=5.0)  # fmt: skip
+        k = coefficients_from_harmonics(fit_harmonics(rec.columns["angle"], rec.columns["accel"]))
+        z += [(k[n][0] - truth[n]) / k[n][1] for n in ("k0", "k1", "delta_o", "k2", "k_ip")]
+    assert 0.8 < float(np.sqrt(np.mean(np.square(z)))) < 1.2

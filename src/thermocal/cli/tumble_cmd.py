@@ -63,11 +63,13 @@ AngleUnitOpt = Annotated[
 TurnRateOpt = Annotated[
     float | None,
     typer.Option(
-        "--turn-rate", help="A continuous tumble at this constant rate [°/s], without an angle column."
+        "--turn-rate",
+        help="A continuous tumble at this constant rate [°/s], without an angle column.",
     ),
 ]
 StartAngleOpt = Annotated[
-    float, typer.Option("--start-angle", help="With --turn-rate: the angle at the first sample [°].")
+    float,
+    typer.Option("--start-angle", help="With --turn-rate: the angle at the first sample [°]."),
 ]
 HarmonicsOpt = Annotated[
     int,

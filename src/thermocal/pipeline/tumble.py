@@ -169,14 +169,16 @@ class TumbleResult:
             **to_dict(self.fit, c),
             "significant": dict(zip(c.names, sig, strict=True)),
             "settle_s": self.settle_s,
-            "stations": [
-                {"start_s": s.start_s, "end_s": s.end_s, "angle_deg": s.angle_deg,
-                 "mean": s.mean, "se": s.se, "n": s.n}
-                for s in self.stations
-            ],  # fmt: skip
+            "stations": [_station_dict(s) for s in self.stations],
             "dropped": [list(d) for d in self.dropped],
             "note": K_PP_NOTE,
         }
+
+
+def _station_dict(s: Station) -> dict[str, Any]:
+    """One station as JSON."""
+    return {"start_s": s.start_s, "end_s": s.end_s, "angle_deg": s.angle_deg, "mean": s.mean,
+            "se": s.se, "n": s.n}  # fmt: skip
 
 
 def _read(path: Path, o: TumbleOptions) -> tuple[Any, np.ndarray, str]:

@@ -4,6 +4,7 @@ and normalised by the scale factor (IEEE Std 1293's form), then the fit's residu
 
 from __future__ import annotations
 
+import math
 from typing import TYPE_CHECKING
 
 from thermocal.report.text import Block, TextTable, fmt
@@ -23,9 +24,12 @@ _NORMALISED = {"k0": ("k0_g", "µg"), "k2": ("k2_g_per_g2", "µg/g²"),
                "k_ip": ("k_ip_g_per_g2", "µg/g²"), "k3": ("k3_g_per_g3", "µg/g³")}  # fmt: skip
 
 
-def _pm(value: float, sigma: float, digits: int = 6) -> str:
-    """``value ± sigma``."""
-    return f"{fmt(value, digits)} ± {fmt(sigma, 2)}"
+def _pm(value: float, sigma: float) -> str:
+    """``value ± sigma``, the value to the decimal of the σ's second significant digit."""
+    if not (math.isfinite(sigma) and sigma > 0):
+        return f"{fmt(value, 6)} ± {fmt(sigma, 2)}"
+    decimals = max(0, 1 - math.floor(math.log10(sigma)))
+    return f"{value:.{decimals}f} ± {fmt(sigma, 2)}"
 
 
 def tumble_text(res: TumbleResult) -> list[Block]:
@@ -58,16 +62,14 @@ def tumble_text(res: TumbleResult) -> list[Block]:
     rows = []
     for name, v, s in zip(c.names, c.values, c.sigmas, strict=True):
         if name == "delta_o":
-            cell, unit = _pm(v * 1e6, s * 1e6, 4), "µrad"
+            cell, unit = _pm(v * 1e6, s * 1e6), "µrad"
         else:
-            cell, unit = _pm(float(v), float(s)), units[name].replace("^2", "²").replace(
-                "^3", "³"
-            )
+            cell, unit = _pm(float(v), float(s)), units[name].replace("^2", "²").replace("^3", "³")
         per_k1 = "—"
         if name in _NORMALISED:
             key, nunit = _NORMALISED[name]
             nv, ns = norm[key]
-            per_k1 = f"{_pm(nv * 1e6, ns * 1e6, 4)} {nunit}"
+            per_k1 = f"{_pm(nv * 1e6, ns * 1e6)} {nunit}"
         rows.append((_LABELS[name], cell, unit, per_k1))
     out.append(
         TextTable(
@@ -83,7 +85,6 @@ def tumble_text(res: TumbleResult) -> list[Block]:
         f"freedom{chi})"
     )
     out.append(
-        "K_pp taken as negligible: one tumble about the output axis gives K2 − K_pp and "
-        "K0 + K_pp"
+        "K_pp taken as negligible: one tumble about the output axis gives K2 − K_pp and K0 + K_pp"
     )
     return out

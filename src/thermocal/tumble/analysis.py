@@ -300,7 +300,9 @@ def fit_harmonics(
     else:
         chi2 = float(np.sum((r * w) ** 2)) / dof
         cov = inv * max(1.0, chi2)
-    return HarmonicFit(int(harmonics), coef, cov, r, chi2, dof, int(yy.size))
+    return HarmonicFit(
+        int(harmonics), np.asarray(coef, np.float64), cov, r, chi2, dof, int(yy.size)
+    )
 
 
 COEFFICIENTS: Final = ("k0", "k1", "delta_o", "k2", "k_ip", "k3")

@@ -37,6 +37,30 @@ def _check(**v: float) -> None:
             raise ParameterError(name, f"{{name}} must be a positive number, got {x!r}")
 
 
+def _head(
+    stations: int,
+    dwell_s: float,
+    step_rate_dps: float,
+    turn_rate_dps: float | None,
+    turns: float,
+    start_deg: float,
+) -> tuple[list[float], list[float], list[float]]:
+    """The head's angle knots (times [s], angles [°]) and the stations' angles [°]."""
+    if turn_rate_dps is not None:
+        duration = 360.0 * turns / turn_rate_dps
+        return [0.0, duration], [start_deg, start_deg + 360.0 * turns], []
+    step = 360.0 / stations
+    angles = [start_deg + k * step for k in range(stations)]
+    knots_t: list[float] = []
+    knots_a: list[float] = []
+    t0 = 0.0
+    for a in angles:
+        knots_t += [t0, t0 + dwell_s]
+        knots_a += [a, a]
+        t0 += dwell_s + step / step_rate_dps
+    return knots_t, knots_a, angles
+
+
 def simulate_tumble(
     rng: np.random.Generator,
     *,
@@ -106,21 +130,9 @@ def simulate_tumble(
     coefs = {**TRUTH, **{k: float(v) for k, v in coefficients.items()}}
     if turn_rate_dps is not None:
         _check(turn_rate_dps=turn_rate_dps)
-        duration = 360.0 * turns / turn_rate_dps
-        knots_t, knots_a = [0.0, duration], [start_deg, start_deg + 360.0 * turns]
-        angles: list[float] = []
-    else:
-        step = 360.0 / stations
-        angles = [start_deg + k * step for k in range(stations)]
-        move = step / step_rate_dps
-        knots_t, knots_a = [], []
-        t0 = 0.0
-        for a in angles:
-            knots_t += [t0, t0 + dwell_s]
-            knots_a += [a, a]
-            t0 += dwell_s + move
-        duration = knots_t[-1]
-    n = int(round(duration * rate_hz))
+    knots_t, knots_a, angles = _head(stations, dwell_s, step_rate_dps, turn_rate_dps, turns,
+                                     start_deg)  # fmt: skip
+    n = round(knots_t[-1] * rate_hz)
     if n > MAX_SIMULATED_SAMPLES:
         raise ParameterError("rate_hz", f"{{name}}: {n} samples, above the budget")
     time = np.arange(n) / rate_hz
