@@ -4214,6 +4214,38 @@ MUTANTS: tuple[Mutant, ...] = (
         _t("tumble_cli"),
         "tumble: NaN angles passed to the fit",
     ),
+    Mutant(
+        "multipos-k2-sign",
+        P + "multipos/accel_k2.py",
+        "a = np.linalg.solve(m, (f - b - k2 * (a / g) ** 2).T).T",
+        "a = np.linalg.solve(m, (f - b + k2 * (a / g) ** 2).T).T",
+        _t("accel_k2"),
+        "multipos K2: the second-order term added where it is taken off",
+    ),
+    Mutant(
+        "multipos-k2-no-slant",
+        P + "multipos/accel_k2.py",
+        "MIN_SLANTED: Final = 3",
+        "MIN_SLANTED: Final = 0",
+        _t("accel_k2"),
+        "multipos K2: poses only along or across an axis accepted for its K2",
+    ),
+    Mutant(
+        "multipos-k2-six-poses",
+        P + "multipos/accel_k2.py",
+        "MIN_POSES_K2: Final = 12",
+        "MIN_POSES_K2: Final = 6",
+        _t("accel_k2"),
+        "multipos K2: the six faces not refused with what they cannot separate",
+    ),
+    Mutant(
+        "multipos-k2-sigma-halved",
+        P + "multipos/accel_k2.py",
+        "np.sqrt(np.diag(cov_p)[9:12])",
+        "np.sqrt(np.diag(cov_p)[9:12]) / 2",
+        _t("accel_k2"),
+        "multipos K2: its σ halved",
+    ),
 )
 
 
