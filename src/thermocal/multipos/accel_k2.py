@@ -20,6 +20,14 @@ unit gravity direction of a pose).  On the six faces ``u_j`` is −1, 0 or +1, s
 ``u_j³ = u_j``: K2 and the bias are one and the same column.  Only poses that put gravity
 at a slant to an axis (``|u_j|`` between :data:`SLANT` bounds: 45° gives 0.71) tell them
 apart; each axis needs :data:`MIN_SLANTED` of them.
+
+**What the gravity magnitude cannot give: the cross-axis terms.**  A term ``K_ji a_j a_i``
+in axis ``j``'s output reaches the residual as ``u_j² u_i``; on the sphere
+``u_i³ + u_j² u_i + u_k² u_i = u_i``, so the bias of ``i``, its K2 and the cross terms
+into it are one column.  (An 18-parameter fit on 40 random poses gave every second-order
+term a σ of 13–20 mg/g², against 0.03 mg/g² for K2 alone.)  They need known attitudes: the
+tumble test (:mod:`thermocal.tumble`) gives one axis's K_ip.  A real cross-axis term left
+out leaks into the same axis's K2.
 """
 
 from __future__ import annotations
