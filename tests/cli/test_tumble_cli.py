@@ -150,3 +150,18 @@ def test_stations_simulated_in_the_library_equal_the_cli(tmp_path: Path) -> None
     assert main(["tumble", str(p), "--angle-column", "angle", "-o", str(tmp_path / "r.json")]) == 0
     res = json.loads((tmp_path / "r.json").read_text())
     assert [round(s["angle_deg"], 6) for s in res["stations"]] == [45.0 * k for k in range(8)]
+
+
+def test_the_report_page(
+    sim: tuple[Path, dict], tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    path, _ = sim
+    page = tmp_path / "tumble.html"
+    assert main(["tumble", str(path), "--angle-column", "angle", "--report", str(page)]) == 0
+    html = page.read_text(encoding="utf-8")
+    assert 'id="fig-tumble-harmonics" src="data:image/png;base64,' in html
+    assert "K2 second order" in html
+    capsys.readouterr()
+    same = ["-o", str(tmp_path / "x.html"), "--report", str(tmp_path / "x.html")]
+    assert main(["tumble", str(path), "--angle-column", "angle", *same]) == 2
+    _one_line_error(capsys, "-o and --report")

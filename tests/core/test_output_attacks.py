@@ -168,6 +168,8 @@ COMMANDS = [
             "table_rate", "--report", o], ("rt.csv",), suffix=".html"),
     Command("tumble", lambda i, o: ["tumble", _s(i["tb.csv"]), "--angle-column", "angle",
             "-o", o], ("tb.csv",), suffix=".json"),
+    Command("tumble-report", lambda i, o: ["tumble", _s(i["tb.csv"]), "--angle-column",
+            "angle", "--report", o], ("tb.csv",), suffix=".html"),
     Command("px4-tempcal", lambda i, o: ["px4-tempcal", _s(i["log.ulg"]), "-o", o],
             ("log.ulg",), kind="dir", writes="calibration.json"),
     Command("ardupilot-tempcal", lambda i, o: ["ardupilot-tempcal", _s(i["log.bin"]), "-o", o],

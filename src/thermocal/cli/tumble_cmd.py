@@ -27,13 +27,16 @@ from thermocal.cli.common import (
     read_options,
     show,
 )
+from thermocal.errors import ThermocalInputError
 
 if TYPE_CHECKING:
     import thermocal.pipeline.tumble as _files
+    import thermocal.report.tumble as _report
     import thermocal.report.tumble_text as _text
     import thermocal.writers as _writers
 else:
     _files = LazyModule("thermocal.pipeline.tumble")
+    _report = LazyModule("thermocal.report.tumble")
     _text = LazyModule("thermocal.report.tumble_text")
     _writers = LazyModule("thermocal.writers")
 
@@ -86,6 +89,10 @@ AngleToleranceOpt = Annotated[
         help="Largest change of the angle between two samples of one station [°].",
     ),
 ]
+ReportOpt = Annotated[
+    Path | None,
+    typer.Option("--report", help="Also write the result as a self-contained HTML page."),
+]
 ResultOpt = Annotated[
     Path | None, typer.Option("-o", "--output", help="Also write the result as JSON here.")
 ]
@@ -106,6 +113,7 @@ def tumble_cmd(
     min_station_s: MinStationOpt = 2.0,
     angle_tolerance_deg: AngleToleranceOpt = 0.01,
     output: ResultOpt = None,
+    report: ReportOpt = None,
     time: TimeOpt = None,
     time_unit: TimeUnitOpt = None,
     t_names: NamesOpt = None,
@@ -117,8 +125,11 @@ def tumble_cmd(
 ) -> None:
     """Accelerometer bias, scale factor, misalignment, second-order K2 and cross-coupling Kip
     from a tumble test (IEEE Std 1293-1998): the output's harmonics against the angle."""
-    if output is not None:
-        _writers.check_not_input(output, [file])
+    for out in (output, report):
+        if out is not None:
+            _writers.check_not_input(out, [file])
+    if output is not None and output == report:
+        raise ThermocalInputError("-o and --report name the same file; give two files")
     opts = _files.TumbleOptions(
         accel,
         accel_unit,
@@ -139,6 +150,8 @@ def tumble_cmd(
     res = _files.tumble_file(file, opts)
     if output is not None:
         _writers.write_json(output, res.to_dict())
+    if report is not None:
+        _writers.write_html(report, _report.tumble_html(res))
     emit(res.to_dict(), as_json, lambda: show(_text.tumble_text(res)))
 
 
