@@ -31,7 +31,7 @@ LAYERS: dict[str, int] = {
     "heater": 2,
     "stability": 2, "models": 2, "compensate.kernels": 2, "simulate": 2, "turntable": 2,
     "multipos": 2, "datasets": 2, "compensate": 2, "firmware": 2, "metrics_streaming": 2,
-    "ratetable": 2, "chamber_join": 2,
+    "ratetable": 2, "chamber_join": 2, "tumble": 2,
     # 3 files: reading, writing, model files, the drivers that stream files
     "readers": 3, "writers": 3,
     "validation": 3, "export": 3, "tempcal": 3,

@@ -107,11 +107,19 @@ def _ratetable(run: Callable[..., str], here: Path) -> list[Path]:
     return [here / "ratetable.html"]
 
 
+def _tumble(run: Callable[..., str], here: Path) -> list[Path]:
+    """An accelerometer's tumble on a dividing head (``simulate tumble``)."""
+    run("simulate", "tumble", "-o", "tb.csv")
+    run("tumble", "tb.csv", "--angle-column", "angle", "--report", "tumble.html")
+    return [here / "tumble.html"]
+
+
 SCENARIOS: tuple[Callable[[Callable[..., str], Path], list[Path]], ...] = (
     _chamber,
     _imu,
     _triads,
     _ratetable,
+    _tumble,
     _fleet,
     _tempcal,
 )

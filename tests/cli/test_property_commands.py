@@ -67,6 +67,8 @@ COMMANDS: dict[str, list[str]] = {
     "validate": ["validate", "{m}", "{f}"],
     "ratetable": ["ratetable", "{f}", "--gyro", "gyro", "--gyro-unit", "deg/s", "--time-unit",
                   "s", "--temps", "T1", "--rates=-10,10", "--min-plateau", "1", "--window", "1"],
+    "tumble": ["tumble", "{f}", "--accel", "gyro", "--accel-unit", "mg", "--time-unit", "s",
+               "--angle-column", "T1", "--angle-unit", "deg", "--min-station", "1"],
 }  # fmt: skip
 UNITS = ["--signal-unit", "deg/h", "--time-unit", "s"]
 TEMP_UNITS = ["--temp-unit", "degC"]
@@ -106,7 +108,7 @@ def test_every_command_exits_0_or_2(
     f = tmp_path / "rec.csv"
     f.write_text(text)
     args = [a.format(f=f, o=tmp_path / "out", m=model) for a in COMMANDS[command]]
-    if command not in ("compensate", "validate", "ratetable"):
+    if command not in ("compensate", "validate", "ratetable", "tumble"):
         args += UNITS + TEMP_UNITS
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")  # numerical warnings are shown as warning: lines

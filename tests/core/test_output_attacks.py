@@ -106,6 +106,10 @@ def assets(tmp_path_factory: pytest.TempPathFactory) -> Path:
     rt, _ = simulate_ladder(np.random.default_rng(0), rates_dps=(-10.0, 0.0, 10.0), dwell_s=6.0,
                             rate_hz=20.0)  # fmt: skip
     write_recording(rt, d / "rt.csv")
+    from thermocal.tumble.simulate import simulate_tumble
+
+    tb, _ = simulate_tumble(np.random.default_rng(0), stations=8, dwell_s=4.0, rate_hz=10.0)
+    write_recording(tb, d / "tb.csv")
     (d / "batch.toml").write_text(config_text({"U1": ("U1.csv", None)}), encoding="utf-8")
     return d
 
@@ -162,6 +166,10 @@ COMMANDS = [
             "table_rate", "-o", o], ("rt.csv",), suffix=".json"),
     Command("ratetable-report", lambda i, o: ["ratetable", _s(i["rt.csv"]), "--rate-column",
             "table_rate", "--report", o], ("rt.csv",), suffix=".html"),
+    Command("tumble", lambda i, o: ["tumble", _s(i["tb.csv"]), "--angle-column", "angle",
+            "-o", o], ("tb.csv",), suffix=".json"),
+    Command("tumble-report", lambda i, o: ["tumble", _s(i["tb.csv"]), "--angle-column",
+            "angle", "--report", o], ("tb.csv",), suffix=".html"),
     Command("px4-tempcal", lambda i, o: ["px4-tempcal", _s(i["log.ulg"]), "-o", o],
             ("log.ulg",), kind="dir", writes="calibration.json"),
     Command("ardupilot-tempcal", lambda i, o: ["ardupilot-tempcal", _s(i["log.bin"]), "-o", o],

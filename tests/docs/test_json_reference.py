@@ -240,6 +240,7 @@ def _other_runs(t: Path) -> list[tuple[str, Any]]:
     """Flight-controller logs, the turntable, multipos, a batch and the demonstrations."""
     _run(["simulate", "turntable-16", "-o", str(t / "tt.csv")])
     _run(["simulate", "ratetable", "--runs", "2", "-o", str(t / "rt")])
+    _run(["simulate", "tumble", "-o", str(t / "tb.csv")])
     rt = sorted(str(p) for p in (t / "rt").glob("*.csv"))
     for seed in (1, 2):
         _run(["simulate", "fog-slow", "-o", str(t / f"SN{seed}.csv"), "--seed", str(seed),
@@ -264,6 +265,7 @@ def _other_runs(t: Path) -> list[tuple[str, Any]]:
         ("compensate", _run(["compensate", str(t / "mp.json"), _timed_ferraris(t),
                              "--time", "time_s", "-o", str(t / "mp-comp.csv")])),
         ("ratetable", _run(["ratetable", *rt, "--rate-column", "table_rate", "--temps", "temp"])),
+        ("tumble", _run(["tumble", str(t / "tb.csv"), "--angle-column", "angle"])),
         ("fleet", _run(["fleet", str(t / "batch.toml"), "-o", str(t / "bo"), "--workers", "1"])),
         ("demo", _run(["demo", "--quick", "-o", str(t / "d1")])),
         ("demo", _run(["demo", "--quick", "--imu", "-o", str(t / "d2")])),

@@ -52,6 +52,7 @@ def test_every_tutorial_is_executed_here() -> None:
         "ros-bags.md",  # tests/docs/test_tutorial_ros_bags.py
         "stability-stable32.md",
         "station.md",  # tests/docs/test_tutorial_station.py
+        "tumble.md",  # tests/docs/test_tutorial_tumble.py
     ]
 
 

@@ -40,6 +40,7 @@ COMMANDS: dict[str, str] = {
     "turntable": "turntable_cmd",
     "multipos": "multipos_cmd",
     "ratetable": "ratetable_cmd",
+    "tumble": "tumble_cmd",
     "report": "report_cmd",
     "fleet": "fleet_cmd",
     "demo": "demo_cmd",

@@ -65,6 +65,10 @@ COMMAND_SUMMARIES: dict[str, str] = {
         "Gyro scale factor, nonlinearity, asymmetry, bias per rate, input threshold and "
         "resolution from a rate-table"
     ),
+    "tumble": (
+        "Accelerometer bias, scale factor, misalignment, second-order K2 and cross-coupling "
+        "Kip from a tumble test"
+    ),
     "report": "Write a self-contained HTML report (figures embedded, no network needed).",
     "fleet": (
         "Calibrate every unit of a production batch: the [fit] options once, one "

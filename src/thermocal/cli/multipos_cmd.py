@@ -181,6 +181,16 @@ GSensitivityOpt = Annotated[
     ),
 ]
 
+AccelK2Opt = Annotated[
+    bool,
+    typer.Option(
+        "--accel-k2",
+        help="Also fit each accelerometer axis's second-order coefficient K2 [unit/g²] "
+        "(needs poses at a slant to every axis, e.g. 45°; the six faces cannot separate it "
+        "from the bias).",
+    ),
+]
+
 
 @app.command("multipos")
 @handle_errors
@@ -207,6 +217,7 @@ def multipos_cmd(
     gyro_offset: GyroOffsetOpt = None,
     gyro_model: GyroModelOpt = "full",
     g_sensitivity: GSensitivityOpt = "auto",
+    accel_k2: AccelK2Opt = False,
     time: TimeOpt = None,
     time_unit: TimeUnitOpt = None,
     accel_scale: AccelScaleOpt = None,
@@ -233,6 +244,7 @@ def multipos_cmd(
         read=read_options(
             names=t_names, rate=t_rate, on_bad_lines=t_bad, delimiter=t_delim, decimal=t_dec
         ),
+        accel_k2=accel_k2,
     )  # fmt: skip
     res = _mpf.calibrate_files(files, output, opts, poses)
     emit(res.to_dict(option_name), as_json,

@@ -65,7 +65,8 @@ TurnsOpt = Annotated[
     typer.Option(
         "--turns",
         help="multipos: Ferraris sessions, the six faces and 360° turns (their sections, "
-        "the --poses object, in the truth).",
+        "the --poses object, in the truth); tumble: a continuous tumble at 2 °/s instead of "
+        "the dividing head's stations.",
     ),
 ]
 FormatOpt = Annotated[str, typer.Option("--format", help="File format inside an output directory.")]

@@ -207,6 +207,9 @@ OPTION_OF: dict[str, str] = {
     "labels": "--label",
     "rates_dps": "--rates",
     "width_c": "--temp-bins",
+    "turn_rate_dps": "--turn-rate",
+    "start_angle_deg": "--start-angle",
+    "angle_tolerance_deg": "--angle-tolerance",
 }
 """Library parameters whose command-line option is not the parameter's name with dashes
 (``time_unit`` → ``--time-unit`` needs no entry)."""

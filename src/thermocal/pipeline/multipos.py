@@ -25,6 +25,7 @@ from thermocal import units
 from thermocal.errors import DesignError, ParameterError, ThermocalInputError, ThermocalWarning
 from thermocal.inspection import saturated_mask
 from thermocal.models.calibration import Calibration, Triad
+from thermocal.multipos.accel_k2 import AccelK2Fit, fit_k2
 from thermocal.multipos.calibrate import METHOD, SessionResult, calibrate_session
 from thermocal.multipos.gsens import SIGNIFICANT_SIGMA, combine_g_sensitivity
 from thermocal.multipos.poses import (
@@ -122,6 +123,9 @@ class MultiposOptions:
     """How to read a text log and its time (``rate_hz``: a sample counter, or samples at
     the nominal rate; ``names`` …), as every command reads it; its columns and units are
     those named above."""
+    accel_k2: bool = False
+    """Also fit each accelerometer axis's second-order coefficient K2 (poses at a slant to
+    every axis needed: :func:`thermocal.multipos.accel_k2.fit_k2`)."""
 
     def check(self, n_files: int, poses: Path | None) -> None:
         """The options' own consistency (before any file is read).
@@ -216,6 +220,8 @@ class SessionRun:
     """The pose detector's choice (None with a POSES file)."""
     offsets: dict[str, float] | None = None
     """Each triad's zero removed before the directions were judged [its unit]."""
+    accel_k2: AccelK2Fit | None = None
+    """The accelerometer fitted with K2 per axis (``accel_k2``), else None."""
 
 
 @dataclass(frozen=True, eq=False)
@@ -619,7 +625,21 @@ def _session(
     res = _with_offsets(res, acc_off_mg, g_off_dh)
     t_range = (float(np.min(temp)), float(np.max(temp))) if temp is not None else None
     offsets = {"accel": a_off, **({"gyro": g_off} if gyr_cols else {})}
-    return SessionRun(path, res, t_range, det, offsets), au, gu
+    k2 = _k2(res, acc_off_mg, str(path)) if opts.accel_k2 else None
+    return SessionRun(path, res, t_range, det, offsets, k2), au, gu
+
+
+def _k2(res: SessionResult, acc_off_mg: float, where: str) -> AccelK2Fit:
+    """The session's accelerometer with K2 per axis from its poses (the columns' zero put
+    back into the bias)."""
+    try:
+        k2 = fit_k2([p.f_mean_mg for p in res.poses], [p.mean_sigma_mg for p in res.poses],
+                    res.g_mg)  # fmt: skip
+    except DesignError as exc:
+        raise DesignError.around(exc, f"{where}: ") from None
+    theta = k2.linear.theta.copy()
+    theta[0:3] += acc_off_mg
+    return replace(k2, linear=replace(k2.linear, theta=theta))
 
 
 def _g_sensitivity(
@@ -865,6 +885,8 @@ def _summary(
                           "g_sensitivity": None if r.g_sensitivity is None
                           else r.g_sensitivity.to_dict(to_g, str(g_unit)),
                           "g_sensitivity_note": r.g_sensitivity_note}  # fmt: skip
+        if run.accel_k2 is not None:
+            rd["accel_k2"] = run.accel_k2.to_dict(to_a, a_unit)
         all_before.append(r.accel.residual_rms_before_mg**2 * len(r.poses))
         all_after.append(r.accel.residual_rms_after_mg**2 * len(r.poses))
         run_dicts.append(rd)

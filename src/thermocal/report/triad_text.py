@@ -192,6 +192,19 @@ def multipos_text(
     return multipos_summary_text(res.to_dict(spell), res.accel_unit, output)
 
 
+def _k2_line(run: dict[str, Any]) -> str:
+    """A run's accelerometer K2 per axis (± 1σ) and the residual with it."""
+    k = run["accel_k2"]
+    terms = ", ".join(
+        f"{ax} {fmt(v, 3)} ± {fmt(e, 2)}" for ax, v, e in zip("xyz", k["k2"], k["k2_sigma"],
+                                                             strict=True)
+    )  # fmt: skip
+    return (
+        f"{run['input']}: accelerometer K2 {terms} {k['unit'].replace('^2', '²')}; "
+        f"gravity-magnitude residual rms with K2 {fmt(k['residual_rms_after'], 3)}"
+    )
+
+
 def multipos_summary_text(out: dict[str, Any], a_unit: str, output: Path | str) -> list[Block]:
     """A multi-position calibration's dictionary as text: each triad's table at TREF, the
     lean of the 360° turns, the poses and the gravity-magnitude residual before → after, the
@@ -224,6 +237,7 @@ def multipos_summary_text(out: dict[str, Any], a_unit: str, output: Path | str) 
                 "(per component, found in the data): counted in the σ, the misalignments "
                 "rest on the motions between poses"
             )
+    blocks += [_k2_line(run) for run in out["runs"] if "accel_k2" in run]
     blocks.append(
         f"{out['n_poses']} poses; gravity-magnitude residual rms "
         f"{fmt(out['gravity_residual_rms_before'], 3)} → "

@@ -794,6 +794,44 @@ def scenario_ratetable(seed: int, profile: ProfileInput = None, **opts: Any) -> 
     return out
 
 
+def scenario_tumble(seed: int, profile: ProfileInput = None, **opts: Any) -> ScenarioResult:
+    """An accelerometer on a dividing head (:func:`thermocal.tumble.simulate.simulate_tumble`):
+    24 stations 15° apart, 20 s each at 50 Hz, with the navigation-grade accelerometer of
+    :data:`thermocal.tumble.simulate.TRUTH` (K2 = 50 µg/g², K_ip = −30 µg/g²); with
+    ``turns``, a continuous tumble at 2 °/s instead.
+
+    Parameters
+    ----------
+    seed : int
+        The seed; the same seed gives the same output.
+    profile : None
+        Must be None (no chamber program).
+    **opts
+        ``rate_hz`` and ``turns``.
+
+    Returns
+    -------
+    list of (Recording, dict)
+        The recording with its truth.
+
+    Raises
+    ------
+    ThermocalInputError
+        A chamber profile or a bad option.
+    """
+    if profile is not None:
+        raise ThermocalInputError("the tumble scenario takes no chamber profile")
+    from thermocal.tumble.simulate import simulate_tumble
+
+    continuous = bool(opts.pop("turns", False))
+    (rng,) = scenario_rng("tumble", seed, 1)
+    try:
+        rec, truth = simulate_tumble(rng, turn_rate_dps=2.0 if continuous else None, **opts)
+    except TypeError as exc:
+        raise ThermocalInputError(f"tumble: {exc}") from None
+    return [(rec, _plain({"scenario": "tumble", "seed": int(seed), **truth}))]
+
+
 IMU_CHANNELS: tuple[tuple[str, str], ...] = (
     ("gx", "deg/s"),
     ("gy", "deg/s"),
@@ -928,6 +966,7 @@ SCENARIOS: dict[str, ScenarioFn] = {
     "mems-imu": scenario_mems_imu,
     "multipos": scenario_multipos,
     "ratetable": scenario_ratetable,
+    "tumble": scenario_tumble,
 }
 """Registry: scenario name → ``fn(seed, profile=None, **opts) -> [(Recording, truth)]``."""
 
@@ -994,7 +1033,8 @@ class SimulateOptions:
     run : str, optional
         ``"modelling"`` or ``"validation"`` (multi-channel scenarios).
     turns : bool, optional
-        Multi-position sessions with the six named faces and 360° turns.
+        Multi-position sessions with the six named faces and 360° turns; a continuous
+        tumble instead of the dividing head's stations (tumble).
 
     Raises
     ------

@@ -1,0 +1,167 @@
+"""``thermocal simulate tumble`` and ``thermocal tumble``: K2 and K_ip against the
+simulator's truth through the command line, the input left untouched, and the one-line
+refusals of what a user can get wrong (NaN angles, one angle, the four quadrants that cannot
+separate the second harmonic, time running backwards, no angle at all)."""
+
+from __future__ import annotations
+
+import hashlib
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from thermocal.cli import main
+from thermocal.recording import Recording
+from thermocal.tumble.simulate import simulate_tumble
+from thermocal.writers import write_recording
+
+
+def _sha(p: Path) -> str:
+    return hashlib.sha256(p.read_bytes()).hexdigest()
+
+
+def _one_line_error(capsys: pytest.CaptureFixture[str], *words: str) -> str:
+    err = [ln for ln in capsys.readouterr().err.strip().splitlines() if ln[:9] != "warning: "]
+    assert len(err) == 1 and err[0].startswith("error: "), err
+    for w in words:
+        assert w in err[0], err[0]
+    return err[0]
+
+
+@pytest.fixture(scope="module")
+def sim(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, dict]:
+    d = tmp_path_factory.mktemp("tb")
+    assert main(["simulate", "tumble", "--seed", "3", "-o", str(d / "tb.csv"),
+                 "--truth", str(d / "truth.json")]) == 0  # fmt: skip
+    return d / "tb.csv", json.loads((d / "truth.json").read_text())["files"][0]
+
+
+def test_simulated_tumble_recovered_through_the_cli(
+    sim: tuple[Path, dict], tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    path, truth = sim
+    before = _sha(path)
+    out = tmp_path / "res.json"
+    assert main(["tumble", str(path), "--angle-column", "angle", "-o", str(out), "--json"]) == 0
+    res = json.loads(capsys.readouterr().out)
+    assert json.loads(out.read_text()) == res and _sha(path) == before
+    assert res["mode"] == "stations" and len(res["stations"]) == 24
+    assert res["units"]["k2"] == "mg/g^2" and res["output_unit"] == "mg"
+    for n in ("k0", "k1", "delta_o", "k2", "k_ip"):
+        assert abs(res["coefficients"][n] - truth[n]) < 3 * res["sigmas"][n], n
+    assert res["significant"]["k2"] and res["significant"]["k_ip"]
+    k2n = res["normalised"]["k2_g_per_g2"]
+    assert abs(k2n["value"] - truth["k2"] / truth["k1"]) < 3 * k2n["sigma"]
+    # the text: K2 in µg/g² per K1
+    assert main(["tumble", str(path), "--angle-column", "angle"]) == 0
+    assert "µg/g²" in capsys.readouterr().out
+
+
+def test_continuous_tumble_through_the_cli(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    p = tmp_path / "tc.csv"
+    assert main(["simulate", "tumble", "--turns", "-o", str(p), "--truth",
+                 str(tmp_path / "t.json"), "--rate-hz", "10"]) == 0  # fmt: skip
+    truth = json.loads((tmp_path / "t.json").read_text())["files"][0]
+    capsys.readouterr()
+    for extra in (["--turn-rate", "2"], ["--angle-column", "angle"]):
+        assert main(["tumble", str(p), *extra, "--json"]) == 0
+        res = json.loads(capsys.readouterr().out)
+        assert res["mode"] == "continuous" and res["stations"] == []
+        for n in ("k2", "k_ip"):
+            assert abs(res["coefficients"][n] - truth[n]) < 3 * res["sigmas"][n], n
+
+
+def _write(tmp: Path, angles: np.ndarray, *, time: np.ndarray | None = None) -> Path:
+    n = angles.size
+    t = np.arange(n) * 0.1 if time is None else time
+    y = 1000.0 * np.cos(np.deg2rad(np.nan_to_num(angles))) + 0.01 * np.sin(np.arange(n))
+    rec = Recording.from_arrays(t, {"accel": y}, signal_unit="mg", other={"angle": angles},
+                                other_units={"angle": "deg"})  # fmt: skip
+    p = tmp / "bad.csv"
+    write_recording(rec, p)
+    return p
+
+
+def _stations(angles: list[float], per: int = 50) -> np.ndarray:
+    return np.repeat(np.asarray(angles, float), per)
+
+
+@pytest.mark.parametrize(
+    ("case", "words"),
+    [
+        ("nan", ("angle column 'angle' are not numbers", "--turn-rate")),
+        ("one", ("1 distinct angle", "K2 and K_ip", "--harmonics")),
+        ("quadrants", ("4 distinct angle", "K2 and K_ip", "24 stations")),
+        ("arc", ("gap of", "spread the angles")),
+        ("backwards", ("time",)),
+        ("no-angle", ("--angle-column", "--turn-rate")),
+        ("both", ("--angle-column", "--turn-rate")),
+        ("missing", ("no column 'nope'", "--angle-column")),
+        ("harmonics", ("--harmonics",)),
+    ],
+)
+def test_what_a_user_gets_wrong_is_one_line(
+    case: str, words: tuple[str, ...], tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    a = _stations(list(np.arange(0.0, 360.0, 30.0)))
+    args = ["--angle-column", "angle"]
+    if case == "nan":
+        a[100] = np.nan
+    elif case == "one":
+        a = _stations([0.0], 300)
+    elif case == "quadrants":
+        a = _stations([0.0, 90.0, 180.0, 270.0] * 3)
+    elif case == "arc":
+        a = _stations(list(np.arange(0.0, 60.0, 5.0)))
+    elif case == "no-angle":
+        args = []
+    elif case == "both":
+        args += ["--turn-rate", "2"]
+    elif case == "missing":
+        args = ["--angle-column", "nope"]
+    elif case == "harmonics":
+        args += ["--harmonics", "1"]
+    t = np.arange(a.size) * 0.1
+    if case == "backwards":
+        t[300:] -= 5.0
+    p = _write(tmp_path, a, time=t)
+    before = _sha(p)
+    assert main(["tumble", str(p), "--min-station", "1", "--settle", "0.5", *args]) == 2
+    _one_line_error(capsys, *words)
+    assert _sha(p) == before
+
+
+def test_a_rate_unit_is_not_an_accelerometer(
+    sim: tuple[Path, dict], capsys: pytest.CaptureFixture[str]
+) -> None:
+    path, _ = sim
+    assert main(["tumble", str(path), "--angle-column", "angle", "--accel-unit", "deg/s"]) == 2
+    _one_line_error(capsys, "a rate", "--accel-unit")
+
+
+def test_stations_simulated_in_the_library_equal_the_cli(tmp_path: Path) -> None:
+    rec, _ = simulate_tumble(np.random.default_rng(0), stations=8, dwell_s=4.0)
+    p = tmp_path / "s.csv"
+    write_recording(rec, p)
+    assert main(["tumble", str(p), "--angle-column", "angle", "-o", str(tmp_path / "r.json")]) == 0
+    res = json.loads((tmp_path / "r.json").read_text())
+    assert [round(s["angle_deg"], 6) for s in res["stations"]] == [45.0 * k for k in range(8)]
+
+
+def test_the_report_page(
+    sim: tuple[Path, dict], tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    path, _ = sim
+    page = tmp_path / "tumble.html"
+    assert main(["tumble", str(path), "--angle-column", "angle", "--report", str(page)]) == 0
+    html = page.read_text(encoding="utf-8")
+    assert 'id="fig-tumble-harmonics" src="data:image/png;base64,' in html
+    assert "K2 second order" in html
+    capsys.readouterr()
+    same = ["-o", str(tmp_path / "x.html"), "--report", str(tmp_path / "x.html")]
+    assert main(["tumble", str(path), "--angle-column", "angle", *same]) == 2
+    _one_line_error(capsys, "-o and --report")
