@@ -154,6 +154,8 @@ class Triad:
         The α, β encoder columns [°] (default ``("alpha_deg", "beta_deg")``).
     latitude_deg : float or None
         Latitude of the calibration runs [°].
+    g_sensitivity, g_sensitivity_sigma : numpy.ndarray, shape (3, 3), or None
+        A gyro triad's sensitivity to specific force ``A`` and its σ [``unit`` per g].
 
     Notes
     -----
