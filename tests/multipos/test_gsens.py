@@ -16,7 +16,7 @@ import pytest
 from thermocal.cli import main
 from thermocal.errors import DesignError
 from thermocal.multipos import Section, calibrate_session
-from thermocal.multipos.gsens import fit_g_sensitivity
+from thermocal.multipos.gsens import fit_g_sensitivity, fit_g_sensitivity_known_rate
 from thermocal.multipos.simulate import random_truth, simulate_ferraris
 
 DH = math.pi / 180.0 / 3600.0  # 1 °/h in rad/s
@@ -55,6 +55,40 @@ def test_too_few_poses_or_poses_in_one_plane_are_refused() -> None:
     flat = up[[0, 1, 3, 4]]  # gravity along ±x and ±y only: A's z column unseen
     with pytest.raises(DesignError, match="do not span the three axes"):
         fit_g_sensitivity(np.zeros((4, 3)), np.full(4, 100), np.full(3, 1e-3), flat)
+
+
+def test_a_force_component_left_by_rounding_is_not_taken_for_a_seen_axis() -> None:
+    """Gravity along ±x and ±y with a z component of 1e-16 g (what rounding a rotation
+    leaves): the z column is unseen, whatever the scale of that component; the direction is
+    named."""
+    rng = np.random.default_rng(1)
+    flat = np.vstack([np.eye(3), -np.eye(3)])[[0, 1, 3, 4]]
+    flat[:, 2] = rng.normal(0.0, 1e-16, 4)
+    with pytest.raises(
+        DesignError, match=r"unseen: specific force along \(\+0.00, \+0.00, \+1.00\)"
+    ):
+        fit_g_sensitivity(np.zeros((4, 3)), np.full(4, 100), np.full(3, 1e-3), flat)
+    line = np.array([[0.0, 0.0, 1.0]] * 3 + [[0.0, 0.0, -1.0]] * 3)
+    line[:, :2] = rng.normal(0.0, 1e-16, (6, 2))
+    with pytest.raises(
+        DesignError, match=r"every gravity direction along \(\+0.00, \+0.00, \+1.00\)"
+    ):
+        fit_g_sensitivity_known_rate(np.zeros((6, 3)), np.full((6, 3), 1e-12), line)
+
+
+def test_with_the_rate_known_each_pair_gives_its_half_difference_and_its_sigma() -> None:
+    """Known-rate residuals of the six faces with per-pose variances: A_ij is the half
+    difference of the pair ±j and its σ is √(v₊ + v₋)/2 (computed here)."""
+    rng = np.random.default_rng(5)
+    up = np.vstack([np.eye(3), -np.eye(3)])
+    r = rng.normal(0.0, 20.0, (6, 3)) * DH
+    var = np.full((6, 3), (0.5 * DH) ** 2)
+    gs = fit_g_sensitivity_known_rate(r, var, up)
+    np.testing.assert_allclose(gs.matrix_deg_h_g, (r[0:3] - r[3:6]).T / 2.0 / DH, rtol=1e-11)
+    # the scatter is far beyond the variances: σ scaled by each axis's reduced χ²
+    chi = gs.reduced_chi2
+    want = np.sqrt(2 * 0.25) / 2.0 * np.sqrt(np.maximum(chi, 1.0))[:, None] * np.ones((3, 3))
+    np.testing.assert_allclose(gs.sigma_deg_h_g, want, rtol=1e-9)
 
 
 def _session(seed: int) -> tuple[np.ndarray, np.ndarray]:
