@@ -49,8 +49,8 @@ def test_the_simulators_sensitivity_is_recovered_within_its_sigma() -> None:
         gs = calibrate(rec, 40.0).g_sensitivity
         assert gs is not None and gs.n_poses == 16 and gs.dof == 12
         z.append(((gs.matrix_deg_h_g - A_TRUE) / gs.sigma_deg_h_g).ravel())
-        # x up at 2 dwells, down at 2: σ of the half difference is per_dwell / 2 (the ARW found in the dwells: ±5 %), more only
-        # when an axis's χ² is significant
+        # x up at 2 dwells, down at 2: σ of the half difference is per_dwell / 2 (the ARW
+        # found in the dwells: ±5 %), more only when an axis's χ² is significant
         assert np.all(gs.sigma_deg_h_g[:, 0] >= 0.95 * per_dwell / 2.0)
         assert np.all(gs.sigma_deg_h_g <= 1.8 * per_dwell / 2.0)
     za = np.abs(np.array(z))
@@ -128,3 +128,26 @@ def test_a_single_column_is_the_half_difference_of_opposite_dwells(column: int) 
     gs = res.g_sensitivity
     assert gs is not None
     np.testing.assert_allclose(gs.matrix_deg_h_g, a, atol=2e-4)
+
+
+def test_soaks_pool_into_one_matrix_weighted_by_their_variances() -> None:
+    """Two runs' estimates and one not estimated: each element the inverse-variance mean
+    (computed here), σ widened by the scatter when it is beyond the σ."""
+    from thermocal.multipos.gsens import GSensitivity
+    from thermocal.turntable.gsens import pooled_g_sensitivity
+
+    def est(a: np.ndarray, s: float) -> GSensitivity:
+        z3 = np.zeros(3)
+        return GSensitivity(a, np.full((3, 3), s), z3, z3, 12, 16, 2.0)
+
+    a1, a2 = A_TRUE, A_TRUE + 0.01
+    got = pooled_g_sensitivity([est(a1, 0.01), None, est(a2, 0.02)])
+    assert got is not None
+    w1, w2 = 1 / 0.01**2, 1 / 0.02**2
+    mean = (w1 * a1 + w2 * a2) / (w1 + w2)
+    np.testing.assert_allclose(got[0], mean, rtol=1e-12)
+    chi = w1 * (a1 - mean) ** 2 + w2 * (a2 - mean) ** 2  # one degree of freedom
+    np.testing.assert_allclose(got[1], np.sqrt(np.maximum(chi, 1.0) / (w1 + w2)), rtol=1e-12)
+    far = pooled_g_sensitivity([est(a1, 0.01), est(a1 + 0.1, 0.01)])
+    assert far is not None and np.all(far[1] > 0.04)  # 10 σ apart: the scatter counts
+    assert pooled_g_sensitivity([None]) is None

@@ -197,4 +197,56 @@ def subtract_from_model(
     return replace(m, y_arcsec=y)
 
 
-__all__ = ["REMEDY", "dwell_g_sensitivity", "specific_force_g", "subtract_from_model"]
+def pooled_g_sensitivity(
+    estimates: Sequence[GSensitivity | None],
+) -> tuple[FloatArray, FloatArray] | None:
+    r"""One ``A`` for several runs (soaks): each element's inverse-variance weighted mean
+    over the runs that estimated it, and its σ (widened by the runs' scatter when it is
+    beyond their σ: a sensitivity that moves with temperature).
+
+    Parameters
+    ----------
+    estimates : sequence of GSensitivity or None
+        Each run's estimate (None: not estimated, left out).
+
+    Returns
+    -------
+    tuple of numpy.ndarray or None
+        ``A`` and its σ [°/h per g], 3×3; None when no run estimated it.
+
+    Notes
+    -----
+    .. math:: \hat A_{ij} = \frac{\sum_r w_r A_{ij,r}}{\sum_r w_r}, \quad
+              w_r = \sigma_{ij,r}^{-2}, \quad
+              \sigma_{ij} = \sqrt{\max(1, \chi^2_\nu) / \textstyle\sum_r w_r}
+
+    with :math:`\chi^2_\nu = \sum_r w_r (A_{ij,r} - \hat A_{ij})^2 / (R - 1)` over the R
+    runs.
+
+    References
+    ----------
+    - S. M. Kay, *Fundamentals of Statistical Signal Processing, Vol. I: Estimation
+      Theory*, Prentice Hall, 1993, ch. 6 (the best linear unbiased estimator of a common
+      mean: the inverse-variance weighted mean).
+    """
+    used = [e for e in estimates if e is not None]
+    if not used:
+        return None
+    a = np.stack([e.matrix_deg_h_g for e in used])
+    w = 1.0 / np.stack([e.sigma_deg_h_g for e in used]) ** 2
+    mean = (w * a).sum(axis=0) / w.sum(axis=0)
+    var = 1.0 / w.sum(axis=0)
+    if len(used) > 1:
+        chi = (w * (a - mean) ** 2).sum(axis=0) / (len(used) - 1)
+        var = var * np.maximum(chi, 1.0)
+    out: tuple[FloatArray, FloatArray] = (mean, np.sqrt(var))
+    return out
+
+
+__all__ = [
+    "REMEDY",
+    "dwell_g_sensitivity",
+    "pooled_g_sensitivity",
+    "specific_force_g",
+    "subtract_from_model",
+]
