@@ -151,3 +151,22 @@ def test_soaks_pool_into_one_matrix_weighted_by_their_variances() -> None:
     far = pooled_g_sensitivity([est(a1, 0.01), est(a1 + 0.1, 0.01)])
     assert far is not None and np.all(far[1] > 0.04)  # 10 σ apart: the scatter counts
     assert pooled_g_sensitivity([None]) is None
+
+
+def test_an_isotropic_sensitivity_is_reported_not_subtracted() -> None:
+    """A = c·I reads c·(g/g₀) along up, as a vertical earth rate off by c would (a latitude
+    of the wrong sign, refused by the residual check): reported with c within 3σ of the
+    truth, not taken off the moves, the note saying why and the text line showing it."""
+    from thermocal.report.triad_text import turntable_g_sensitivity_line
+
+    rec, _truth = simulate_turntable16(0, rate_hz=20.0, g_sensitivity_deg_h_g=0.3 * np.eye(3))
+    with warnings.catch_warnings(record=True):
+        warnings.simplefilter("always", TurntableWarning)  # the drift left in: residuals
+        res = calibrate(rec, 40.0)
+    gs = res.g_sensitivity
+    assert gs is not None and not res.g_sensitivity_subtracted
+    assert np.all(np.abs(np.diag(gs.matrix_deg_h_g) - 0.3) < 3.0 * np.diag(gs.sigma_deg_h_g))
+    note = res.g_sensitivity_note or ""
+    assert note.startswith("the g-sensitivity is c·I alone (c = 0.") and "latitude" in note
+    line = turntable_g_sensitivity_line(res.to_dict(), "run.csv") or ""
+    assert line.endswith(f"not compensated by this calibration; {note})"), line

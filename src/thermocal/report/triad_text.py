@@ -108,7 +108,8 @@ def g_sensitivity_line(run: dict[str, Any], what: str = "poses") -> str | None:
         worst = max(max(row) for row in gs["matrix_sigma"])
         return head + f"none beyond 3σ (σ ≤ {fmt(worst, 2)})"
     done = "; taken off the rotations before the fit" if g.get("g_sensitivity_subtracted") else ""
-    return head + "; ".join(found) + f" (beyond 3σ{done}; not compensated by this calibration)"
+    why = f"; {g['g_sensitivity_note']}" if g.get("g_sensitivity_note") else ""
+    return head + "; ".join(found) + f" (beyond 3σ{done}; not compensated by this calibration{why})"
 
 
 def pose_detection_lines(out: dict[str, Any]) -> list[str]:

@@ -195,7 +195,7 @@ class TurntableResult:
     g_sensitivity: GSensitivity | None = None
     """The gyro's g-sensitivity from the dwells [°/h/g] (:mod:`.gsens`)."""
     g_sensitivity_note: str | None = None
-    """Why it was not estimated (None when it was)."""
+    """Why it was not estimated, or not subtracted although significant (else None)."""
     g_sensitivity_subtracted: bool = False
     """A significant g-sensitivity taken off the moves before the estimate reported."""
 
@@ -634,6 +634,14 @@ def calibrate(
     )  # fmt: skip
 
 
+ISOTROPIC_NOTE = (
+    "the g-sensitivity is c·I alone (c = {c:.3g} ± {s:.2g} °/h/g): what a vertical earth "
+    "rate off by c gives (a latitude of the wrong sign), so it is not taken off the moves; "
+    "check the latitude"
+)
+"""Why an isotropic ``A`` (:func:`.gsens.isotropic_part`) is reported but not subtracted."""
+
+
 def _estimate_channels(
     channels: int,
     arw: FloatArray,
@@ -673,6 +681,9 @@ def _g_sensitivity(
         gs = fit(est)
     except DesignError as exc:
         return est, (None, str(exc), False)
+    iso = gsens_mod.isotropic_part(gs)
+    if iso is not None:
+        return est, (gs, ISOTROPIC_NOTE.format(c=iso[0], s=iso[1]), False)
     if not bool(np.any(gs.significant)):
         return est, (gs, None, False)
     est = again(gsens_mod.subtract_from_model(full, gs.matrix_deg_h_g, *angles_deg, g_m_s2))
