@@ -737,7 +737,8 @@ def _summary(
                               r.gyro.direction_rms_after_rad),
                           "g_sensitivity": None if r.g_sensitivity is None
                           else r.g_sensitivity.to_dict(to_g, str(g_unit)),
-                          "g_sensitivity_note": r.g_sensitivity_note}  # fmt: skip
+                          "g_sensitivity_note": r.g_sensitivity_note,
+                          "g_sensitivity_subtracted": r.g_sensitivity_subtracted}  # fmt: skip
         all_before.append(r.accel.residual_rms_before_mg**2 * len(r.poses))
         all_after.append(r.accel.residual_rms_after_mg**2 * len(r.poses))
         run_dicts.append(rd)
