@@ -306,8 +306,8 @@ def _check_design(f: FloatArray, what: str, remedy: str) -> float:
         )
     # f in g has its own scale (a column scaled by its norm would make a force component
     # that only rounding leaves off zero, 1e-16 g, look as well seen as the others)
-    x = np.column_stack([np.ones(m), f])
-    _u, s, vt = np.linalg.svd(x, full_matrices=False)
+    design = np.column_stack([np.ones(m), f])
+    _u, s, vt = np.linalg.svd(design, full_matrices=False)
     cond = float(s[0] / s[-1]) if s[-1] > 0 else math.inf
     if not cond <= MAX_DESIGN_COND:
         raise DesignError(
