@@ -81,8 +81,10 @@ def specific_force_g(
 
     Examples
     --------
-    >>> specific_force_g(0.0, 90.0, 9.80665).round(6).tolist()  # inner axis (z) up
+    >>> (specific_force_g(0.0, 90.0, 9.80665).round(6) + 0.0).tolist()  # inner axis (z) up
     [0.0, 0.0, 1.0]
+    >>> (specific_force_g(90.0, 0.0, 9.80665).round(6) + 0.0).tolist()  # body x down
+    [-1.0, 0.0, 0.0]
     """
     out: FloatArray = (
         gravity_in_body(alpha_deg, beta_deg, gravity_m_s2) / units.STANDARD_GRAVITY_M_S2
