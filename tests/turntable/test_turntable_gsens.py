@@ -184,3 +184,26 @@ def test_a_schedule_started_turned_and_tilted_still_separates_it() -> None:
         assert gs is not None and res.g_sensitivity_subtracted
         assert np.all(np.abs(gs.matrix_deg_h_g - A_TRUE) < 3.0 * gs.sigma_deg_h_g)
         assert np.all(np.abs(res.kalman.theta - _theta(truth)) < 3.5 * res.kalman.sigma)
+
+
+def test_runs_over_temperature_state_each_runs_sensitivity(tmp_path: Path) -> None:
+    """Three soaks of a triad without a g-sensitivity: one text line per run (none beyond
+    3σ, each from its 16 dwells) and each run's JSON holding its matrix."""
+    from thermocal.turntable.simulate import simulate_turntable_thermal
+
+    files = []
+    for rec, truth in simulate_turntable_thermal(seed=2, soaks_c=(-20.0, 20.0, 60.0)):
+        if not truth["held_out"]:
+            files.append(tmp_path / f"{truth['label']}.parquet")
+            write_recording(rec, files[-1])
+    args = ["turntable", *map(str, files), "--temps", "T_imu", "--order", "1", "-o"]
+    text, js = io.StringIO(), io.StringIO()
+    with contextlib.redirect_stdout(text):
+        assert main([*args, str(tmp_path / "a.json")]) == 0
+    with contextlib.redirect_stdout(js):
+        assert main([*args, str(tmp_path / "b.json"), "--json"]) == 0
+    lines = [ln for ln in text.getvalue().splitlines() if "gyro g-sensitivity" in ln]
+    assert len(lines) == 3 and all("from 16 dwells" in ln for ln in lines), lines
+    assert all("none beyond 3σ" in ln for ln in lines), lines
+    runs = json.loads(js.getvalue())["runs"]
+    assert [np.shape(r["g_sensitivity"]["matrix"]) for r in runs] == [(3, 3)] * 3
