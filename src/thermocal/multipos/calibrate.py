@@ -258,6 +258,9 @@ class SessionResult:
         poses cannot separate it).
     g_sensitivity_note : str or None
         Why it is None with a gyro (the poses it would need).
+    g_sensitivity_subtracted : bool
+        Whether an element of it was beyond 3σ and ``A f(t)`` was taken off the rates before
+        the gyro's bias, scale factors and misalignments were fitted.
     """
 
     accel: _accel.AccelFit
@@ -269,6 +272,7 @@ class SessionResult:
     not_still: tuple[str, ...] = field(default=())
     g_sensitivity: _gsens.GSensitivity | None = None
     g_sensitivity_note: str | None = None
+    g_sensitivity_subtracted: bool = False
 
     def to_dict(self) -> dict[str, Any]:
         """The session's calibration as plain JSON types: ``accel`` and ``gyro``
@@ -277,7 +281,8 @@ class SessionResult:
         gyro), ``g_mg`` [mg], ``temperature_c`` [°C], ``poses`` (:meth:`poses_dict`),
         ``turns`` (name, start, end), ``not_still`` and, with a gyro, ``g_sensitivity``
         (:meth:`GSensitivity.to_dict <thermocal.multipos.gsens.GSensitivity.to_dict>` in
-        °/h/g, None when the poses cannot separate it) and ``g_sensitivity_note`` (why)."""
+        °/h/g, None when the poses cannot separate it), ``g_sensitivity_note`` (why) and
+        ``g_sensitivity_subtracted``."""
         out: dict[str, Any] = {
             "accel": self.accel.to_dict(),
             "gyro": None if self.gyro is None else self.gyro.to_dict(),
@@ -291,6 +296,7 @@ class SessionResult:
             gs = self.g_sensitivity
             out["g_sensitivity"] = None if gs is None else gs.to_dict()
             out["g_sensitivity_note"] = self.g_sensitivity_note
+            out["g_sensitivity_subtracted"] = self.g_sensitivity_subtracted
         return out
 
     def table(self) -> list[dict[str, Any]]:
@@ -597,6 +603,22 @@ def _g_sensitivity(
     return gs, None
 
 
+def _without_g_drift(
+    a: FloatArray, w: FloatArray, stats: Sequence[PoseStats], acc: _accel.AccelFit,
+    gs: _gsens.GSensitivity | None,
+) -> tuple[FloatArray, list[PoseStats], bool]:  # fmt: skip
+    """The rates the rotations' fit takes: with an element of the g-sensitivity beyond 3σ,
+    ``ω − A f(t)`` at every sample (``f`` the calibrated specific force in g,
+    ``(I + E_a)⁻¹(f_meas − b_a) / 1000``: the hand's accelerations too), the poses' means
+    again, True; else the rates and poses as they are, False."""
+    if gs is None or not bool(np.any(gs.significant)):
+        return w, list(stats), False
+    e_a = model.error_matrices(acc.theta)
+    f_g = np.linalg.solve(np.eye(3) + e_a, (a - acc.theta[0:3]).T).T / units.G_TO_MG
+    w_fit = w - f_g @ (gs.matrix_deg_h_g * units.DH_TO_RS).T
+    return w_fit, pose_stats(a, w_fit, [p.section for p in stats]), True
+
+
 def _gyro_fit(
     t: FloatArray, a: FloatArray, w: FloatArray, stats: Sequence[PoseStats],
     turns: Sequence[Section], acc: _accel.AccelFit, idx: Sequence[int], g_mg: float,
@@ -716,14 +738,15 @@ def calibrate_session(
         )
     acc, idx = _accel_fit(stats, g_mg, where, sections_from)
     temp = None if temperature_c is None else _mean_over(temperature_c, statics)
-    gfit, gsens, gnote = None, None, None
+    gfit, gsens, gnote, subtracted = None, None, None, False
     if w is not None:
         sat = None if saturated is None else np.asarray(saturated, dtype=bool)
-        gfit = _gyro_fit(t, a, w, stats, turns, acc, idx, g_mg, latitude_deg, sat,
-                         gyro_model, where, sections_from)  # fmt: skip
         gsens, gnote = _g_sensitivity(stats, acc, idx, g_mg, latitude_deg)
+        w_fit, stats_fit, subtracted = _without_g_drift(a, w, stats, acc, gsens)
+        gfit = _gyro_fit(t, a, w_fit, stats_fit, turns, acc, idx, g_mg, latitude_deg, sat,
+                         gyro_model, where, sections_from)  # fmt: skip
     return SessionResult(acc, gfit, tuple(stats), tuple(turns), g_mg, temp, not_still,
-                         gsens, gnote)  # fmt: skip
+                         gsens, gnote, subtracted)  # fmt: skip
 
 
 @dataclass(frozen=True)

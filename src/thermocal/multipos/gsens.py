@@ -26,9 +26,15 @@ difference of a face pair.  Its covariance is :math:`(X^\top W X)^{-1}`, scaled 
 reduced χ² when the scatter is beyond the noise model (a bias that also drifts with
 time or temperature between the poses).
 
-The matrix is an estimate of the gyro's sensitivity, reported with its σ: the rotations'
-fit (:mod:`thermocal.multipos.gyro`) does not model it, so on a gyro with a large one the
-motions carry it as a misfit (their reduced χ²).
+The matrix is an estimate of the gyro's sensitivity, reported with its σ.  When an element
+is beyond :data:`SIGNIFICANT_SIGMA` σ, the session's calibration
+(:func:`thermocal.multipos.calibrate_session`) takes ``A f(t)`` off every sample's rate,
+``f`` the calibrated accelerometer's reading in g (the hand's accelerations too), before the
+gyro's bias and the rotations' fit (:mod:`thermocal.multipos.gyro`): left in, the drift
+along each turn is taken for scale factor (a simulated Ferraris session with A up to
+0.1 °/s/g: scale factors 3–12σ off; imu_tk's Xsens session: the motions' reduced χ² 110,
+4.8 with it taken off).  A's own σ is not carried into the rotations' covariance (on those
+sessions the gyro's θ then stays within 3.5σ of the truth, as without a sensitivity).
 """
 
 from __future__ import annotations
@@ -49,7 +55,7 @@ MIN_POSES = 4
 """Poses the fit of eq. (1) needs per axis (a bias and three sensitivities)."""
 
 MAX_DESIGN_COND = 1e4
-"""Largest condition number of the column-scaled design ``[1, f_x, f_y, f_z]`` accepted:
+"""Largest condition number of the design ``[1, f_x, f_y, f_z]`` (f in g) accepted:
 beyond it the poses' gravity directions lie (nearly) in one plane through the board and one
 column of ``A`` is not seen."""
 
@@ -76,7 +82,7 @@ class GSensitivity:
     n_poses : int
         Static poses used.
     design_cond : float
-        Condition number of the column-scaled design.
+        Condition number of the design ``[1, f]`` (f in g).
     """
 
     matrix_deg_h_g: FloatArray
@@ -209,28 +215,133 @@ def fit_g_sensitivity(
     n = np.asarray(n_samples, dtype=np.float64).ravel()
     sig = np.asarray(rate_sigma_rad_s, dtype=np.float64).ravel()
     f = np.asarray(specific_force_g, dtype=np.float64).reshape(-1, 3)
-    m = w.shape[0]
-    if m < MIN_POSES:
-        raise DesignError(
-            f"the gyro's g-sensitivity needs at least {MIN_POSES} static poses (a bias and "
-            f"three sensitivities per axis), got {m}"
-        )
+    cond = _check_design(f, "static poses", POSES_REMEDY)
     norm = np.linalg.norm(f, axis=1, keepdims=True)
     up = f / np.where(norm > 0, norm, 1.0)
-    x = np.column_stack([np.ones(m), f])
-    scale = np.linalg.norm(x, axis=0)
-    s = np.linalg.svd(x / np.where(scale > 0, scale, 1.0), compute_uv=False)
-    cond = float(s[0] / s[-1]) if s[-1] > 0 else math.inf
-    if not cond <= MAX_DESIGN_COND:
-        raise DesignError(
-            f"the gyro's g-sensitivity is not separable from these {m} poses: their gravity "
-            f"directions do not span the three axes (design condition number {cond:.3g}); "
-            "add poses with gravity along each axis in both senses (the six faces)"
-        )
     y = w.copy()
     if latitude_deg is not None:
         y = y - units.EARTH_RATE_RAD_S * math.sin(math.radians(latitude_deg)) * up
-    var = _noise_var(n, sig, up, latitude_deg)
+    return _fit(y, _noise_var(n, sig, up, latitude_deg), f, cond)
+
+
+POSES_REMEDY = "add poses with gravity along each axis in both senses (the six faces)"
+"""What gets a multi-position session's g-sensitivity separable."""
+
+
+def fit_g_sensitivity_known_rate(
+    residual_means_rad_s: npt.ArrayLike,
+    variance_rad2_s2: npt.ArrayLike,
+    specific_force_g: npt.ArrayLike,
+    *,
+    what: str = "dwells",
+    remedy: str = POSES_REMEDY,
+) -> GSensitivity:
+    r"""``A`` and its σ from still positions whose whole true rate is known (a turntable's
+    encoders and a levelled, aligned base give the earth rate in body axes): eq. (1) with
+    the earth rate, scale factors and misalignments already taken off by the caller.
+
+    Parameters
+    ----------
+    residual_means_rad_s : array_like, shape (m, 3)
+        Each position's mean rate less ``(I + E) ω_true`` [rad/s]: ``b + A f_k + e_k``.
+    variance_rad2_s2 : array_like, shape (m, 3)
+        The variance of each mean per axis [rad²/s²] (white noise: ``N² / T_k``, N the
+        angle random walk [rad/√s] and ``T_k`` the time held [s]).
+    specific_force_g : array_like, shape (m, 3)
+        Each position's specific force in body axes [g].
+    what : str, optional
+        What the positions are called in a refusal (``"dwells"``).
+    remedy : str, optional
+        What gets the user further, in a refusal.
+
+    Returns
+    -------
+    GSensitivity
+        ``A`` [°/h/g], its σ, the bias at zero specific force [°/h], each axis's reduced χ².
+
+    Raises
+    ------
+    thermocal.errors.DesignError
+        Fewer than :data:`MIN_POSES` positions, or gravity directions that do not span the
+        three axes (the unseen direction named).
+
+    Notes
+    -----
+    Per gyro axis i, the weighted least squares of :func:`fit_g_sensitivity` with known
+    variances :math:`\sigma_{ki}^2`:
+
+    .. math::
+
+        \min_{b_i, A_i} \sum_k \frac{(r_{ki} - b_i - A_i f_k)^2}{\sigma_{ki}^2}
+
+    References
+    ----------
+    - IEEE Std 1431-2004, *IEEE Standard Specification Format Guide and Test Procedure for
+      Coriolis Vibratory Gyros* (the acceleration-sensitive drift of the rate model).
+    - IEEE Std 952-1997, annex B (acceleration-sensitive drift).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> up = np.vstack([np.eye(3), -np.eye(3)])
+    >>> a = np.zeros((3, 3)); a[1, 0] = 3.6
+    >>> r = (up @ a.T) * np.pi / 180 / 3600
+    >>> gs = fit_g_sensitivity_known_rate(r, np.full((6, 3), 1e-14), up)
+    >>> round(float(gs.matrix_deg_h_g[1, 0]), 6)
+    3.6
+    """
+    r = np.asarray(residual_means_rad_s, dtype=np.float64).reshape(-1, 3)
+    var = np.asarray(variance_rad2_s2, dtype=np.float64).reshape(-1, 3)
+    f = np.asarray(specific_force_g, dtype=np.float64).reshape(-1, 3)
+    return _fit(r, var, f, _check_design(f, what, remedy))
+
+
+def _check_design(f: FloatArray, what: str, remedy: str) -> float:
+    """The scaled design's condition number; refuses too few positions or directions that
+    do not span the axes (naming the unseen direction, body axes)."""
+    m = f.shape[0]
+    if m < MIN_POSES:
+        raise DesignError(
+            f"the gyro's g-sensitivity needs at least {MIN_POSES} {what} (a bias and "
+            f"three sensitivities per axis), got {m}"
+        )
+    # f in g has its own scale (a column scaled by its norm would make a force component
+    # that only rounding leaves off zero, 1e-16 g, look as well seen as the others)
+    design = np.column_stack([np.ones(m), f])
+    _u, s, vt = np.linalg.svd(design, full_matrices=False)
+    cond = float(s[0] / s[-1]) if s[-1] > 0 else math.inf
+    if not cond <= MAX_DESIGN_COND:
+        raise DesignError(
+            f"the gyro's g-sensitivity is not separable from these {m} {what}: their gravity "
+            f"directions do not span the three axes (design condition number {cond:.3g}; "
+            f"{_unseen(s, vt)}); {remedy}"
+        )
+    return cond
+
+
+def _unseen(s: FloatArray, vt: FloatArray) -> str:
+    """The specific-force directions the design ``[1, f]`` does not see (its singular values
+    ``s`` and right vectors ``vt``), in words, body axes."""
+
+    def shown(v: FloatArray) -> str:
+        d = v / max(float(np.linalg.norm(v)), 1e-300)
+        d = np.round(d * (1.0 if d[int(np.argmax(np.abs(d)))] >= 0 else -1.0), 2) + 0.0
+        return f"({d[0]:+.2f}, {d[1]:+.2f}, {d[2]:+.2f})"
+
+    weak = vt[s * MAX_DESIGN_COND < s[0], 1:]
+    if weak.shape[0] >= 2:
+        return (
+            "every gravity direction along "
+            f"{shown(np.cross(weak[0], weak[1]))}: the force across it unseen"
+        )
+    return f"unseen: specific force along {shown(vt[-1, 1:])} in body axes"
+
+
+def _fit(y: FloatArray, var: FloatArray, f: FloatArray, cond: float) -> GSensitivity:
+    """Each axis's fit of eq. (1) on the prepared means ``y`` and variances ``var`` (the
+    design's condition number ``cond`` checked before)."""
+    m = f.shape[0]
+    x = np.column_stack([np.ones(m), f])
     to_dh = 1.0 / units.DH_TO_RS
     fits = [_solve_axis(x, y[:, i], var[:, i]) for i in range(3)]
     coef = np.array([c for c, _, _ in fits]) * to_dh
@@ -324,8 +435,10 @@ def _solve_axis(
 __all__ = [
     "MAX_DESIGN_COND",
     "MIN_POSES",
+    "POSES_REMEDY",
     "SIGNIFICANT_SIGMA",
     "GSensitivity",
     "combine_g_sensitivity",
     "fit_g_sensitivity",
+    "fit_g_sensitivity_known_rate",
 ]

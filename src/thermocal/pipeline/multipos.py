@@ -884,7 +884,8 @@ def _summary(
                               r.gyro.direction_rms_after_rad),
                           "g_sensitivity": None if r.g_sensitivity is None
                           else r.g_sensitivity.to_dict(to_g, str(g_unit)),
-                          "g_sensitivity_note": r.g_sensitivity_note}  # fmt: skip
+                          "g_sensitivity_note": r.g_sensitivity_note,
+                          "g_sensitivity_subtracted": r.g_sensitivity_subtracted}  # fmt: skip
         if run.accel_k2 is not None:
             rd["accel_k2"] = run.accel_k2.to_dict(to_a, a_unit)
         all_before.append(r.accel.residual_rms_before_mg**2 * len(r.poses))

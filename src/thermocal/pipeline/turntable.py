@@ -504,6 +504,7 @@ def thermal_runs(
         tref_c=tref_c, order=order,
     )  # fmt: skip
     triads = [Triad("gyro", opts.gyro, gyro_unit, temps, gyro_model, rig, latitude, record)]
+    # TODO(lead, after z3-gsens-apply): Triad(..., g_sensitivity=, g_sensitivity_sigma=, g_sensitivity_unit=f"{gyro_unit}/g") from thermocal.turntable.gsens.pooled_g_sensitivity([r.g_sensitivity for _f, r in runs]) (°/h/g: × units.convert(1.0, "deg/h", gyro_unit) per g)  # noqa: E501
     accel_model = None
     if opts.accel is not None:
         accel_model = _thermal.fit_triad(

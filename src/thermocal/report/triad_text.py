@@ -67,7 +67,7 @@ def gyro_misfit_line(run: dict[str, Any]) -> str | None:
     )
 
 
-def g_sensitivity_line(run: dict[str, Any]) -> str | None:
+def g_sensitivity_line(run: dict[str, Any], what: str = "poses") -> str | None:
     """The gyro's sensitivity to specific force found in a run's static poses: the elements
     beyond 3σ with their σ (or that none is), or why the poses cannot separate it; None
     without a gyro.
@@ -75,7 +75,10 @@ def g_sensitivity_line(run: dict[str, Any]) -> str | None:
     Parameters
     ----------
     run : dict
-        One run of a multi-position result's ``runs`` (its ``gyro`` figures).
+        One run of a multi-position result's ``runs`` (its ``gyro`` figures), or of a
+        turntable's (``gyro`` holding its ``g_sensitivity`` keys).
+    what : str, optional
+        What the still positions are called (``poses``, a turntable's ``dwells``).
 
     Returns
     -------
@@ -98,13 +101,15 @@ def g_sensitivity_line(run: dict[str, Any]) -> str | None:
         if gs["significant"][i][j]
     ]
     head = (
-        f"{run['input']}: gyro g-sensitivity from {gs['n_poses']} poses "
+        f"{run['input']}: gyro g-sensitivity from {gs['n_poses']} {what} "
         f"[{gs['unit']}, gyro/force axis]: "
     )
     if not found:
         worst = max(max(row) for row in gs["matrix_sigma"])
         return head + f"none beyond 3σ (σ ≤ {fmt(worst, 2)})"
-    return head + "; ".join(found) + " (beyond 3σ)"
+    done = "; taken off the rotations before the fit" if g.get("g_sensitivity_subtracted") else ""
+    why = f"; {g['g_sensitivity_note']}" if g.get("g_sensitivity_note") else ""
+    return head + "; ".join(found) + f" (beyond 3σ{done}{why})"
 
 
 def g_sensitivity_stored_line(out: dict[str, Any]) -> str | None:
@@ -295,12 +300,40 @@ def turntable_text(res: SingleRunResult) -> list[Block]:
     )  # fmt: skip
     columns = ("coefficient", "value", "σ", "CRB σ", "least squares", "unit")
     title = f"turntable calibration of {res.input} ({out['method']})"
-    return [
+    blocks: list[Block] = [
         TextTable(title, columns, rows, ("left",) * len(columns)),
         f"inner-axis azimuth (yx − xy)/2: {fmt(out['inner_axis_azimuth_arcsec'], 4)} ± "
         f"{fmt(out['inner_axis_azimuth_arcsec_sigma'], 3)} ″; "
         f"filter/LS agreement {fmt(out['agreement_max_sigma'], 2)} σ; written {res.output}",
     ]
+    line = turntable_g_sensitivity_line(out, str(res.input))
+    return blocks + ([line] if line is not None else [])
+
+
+def turntable_g_sensitivity_line(out: dict[str, Any], name: str) -> str | None:
+    """A turntable run's g-sensitivity line (:func:`g_sensitivity_line` on its dwells).
+
+    Parameters
+    ----------
+    out : dict
+        The run's result dictionary (``g_sensitivity``, ``g_sensitivity_note``,
+        ``g_sensitivity_subtracted``).
+    name : str
+        The run's file, heading the line.
+
+    Returns
+    -------
+    str or None
+        None for a result without the keys.
+
+    References
+    ----------
+    IEEE Std 1431-2004 (the acceleration-sensitive drift of the rate model).
+    """
+    if "g_sensitivity" not in out:
+        return None
+    keys = ("g_sensitivity", "g_sensitivity_note", "g_sensitivity_subtracted")
+    return g_sensitivity_line({"input": name, "gyro": {k: out[k] for k in keys}}, "dwells")
 
 
 def turntable_thermal_text(res: ThermalRunsResult) -> list[Block]:
@@ -336,15 +369,20 @@ def turntable_thermal_text(res: ThermalRunsResult) -> list[Block]:
         )  # fmt: skip
         columns = ("parameter", "unit", "order", "at TREF", "σ", "LOTO rms")
         blocks.append(TextTable(title, columns, rows, ("left",) * len(columns)))
+    for f, r in res.runs:
+        line = turntable_g_sensitivity_line(r.to_dict(), str(f))
+        blocks += [line] if line is not None else []
     blocks.append(f"calibration written: {res.output} (compensate applies it per sample)")
     return blocks
 
 
 __all__ = [
+    "g_sensitivity_line",
     "gyro_misfit_line",
     "multipos_summary_text",
     "multipos_text",
     "pose_detection_lines",
+    "turntable_g_sensitivity_line",
     "turntable_text",
     "turntable_thermal_text",
 ]

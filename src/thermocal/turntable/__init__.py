@@ -14,7 +14,9 @@ Modules: :mod:`.kinematics` (frames, the true body rate from the encoder angles)
 model, measurement model, Cramér–Rao bound), :mod:`.simulate` (runs with a known truth),
 :mod:`.estimate_ls` (batch least squares), :mod:`.kalman` (14/15-state filter),
 :mod:`.calibration` (one run end to end, the validation on another run), :mod:`.accel` (the
-accelerometer triad from the dwells), :mod:`.thermal` (every coefficient over temperature).
+accelerometer triad from the dwells), :mod:`.thermal` (every coefficient over temperature),
+:mod:`.gsens` (the gyro's sensitivity to specific force from the dwells, its drift taken off
+the moves when significant).
 
 Notes
 -----

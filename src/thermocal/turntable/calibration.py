@@ -10,11 +10,12 @@ the Cramér–Rao bound of the design (:func:`.model.fisher_information`).
 from __future__ import annotations
 
 import dataclasses
+import functools
 import math
 import warnings
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import numpy.typing as npt
@@ -22,6 +23,7 @@ import numpy.typing as npt
 from thermocal import units
 from thermocal.defaults import DEFAULT_GYRO_COLUMNS as DEFAULT_GYRO_COLUMNS
 from thermocal.errors import (
+    DesignError,
     MissingValueError,
     ParameterError,
     ThermocalInputError,
@@ -31,8 +33,12 @@ from thermocal.errors import (
 from thermocal.recording import Recording
 from thermocal.turntable import accel as accel_mod
 from thermocal.turntable import estimate_ls, kalman, model, schedule
+from thermocal.turntable import gsens as gsens_mod
 from thermocal.turntable.model import SCALE_FACTOR_REFUSED
 from thermocal.turntable.schedule import TurntableWarning
+
+if TYPE_CHECKING:
+    from thermocal.multipos.gsens import GSensitivity
 
 FloatArray = npt.NDArray[np.float64]
 
@@ -145,6 +151,12 @@ class TurntableResult:
         Local gravity used [m/s²].
     temperature_c, temperature_span_c : float or None
         Mean temperature and its range over the run [°C].
+    g_sensitivity : GSensitivity or None
+        The gyro's sensitivity to specific force from the dwells (:mod:`.gsens`); None when
+        the dwells' gravity directions cannot separate it, with the reason in
+        ``g_sensitivity_note``.
+    g_sensitivity_subtracted : bool
+        Whether a significant one was taken off the moves and the run estimated again.
     """
 
     kalman: Estimate
@@ -180,6 +192,12 @@ class TurntableResult:
     """Mean of the run's temperature column [°C] (``temperature_column`` given)."""
     temperature_span_c: float | None = None
     """Its range over the run (max − min) [°C]: a soak that drifts during the run."""
+    g_sensitivity: GSensitivity | None = None
+    """The gyro's g-sensitivity from the dwells [°/h/g] (:mod:`.gsens`)."""
+    g_sensitivity_note: str | None = None
+    """Why it was not estimated, or not subtracted although significant (else None)."""
+    g_sensitivity_subtracted: bool = False
+    """A significant g-sensitivity taken off the moves before the estimate reported."""
 
     def to_dict(self, spell: Callable[[str], str] | None = None) -> dict[str, Any]:
         """JSON-ready dict of the result file's keys (from the Kalman filter).
@@ -235,6 +253,10 @@ class TurntableResult:
         if self.temperature_c is not None:
             out["temperature_c"] = self.temperature_c
             out["temperature_span_c"] = self.temperature_span_c
+        gs = self.g_sensitivity
+        out["g_sensitivity"] = None if gs is None else gs.to_dict()
+        out["g_sensitivity_note"] = self.g_sensitivity_note
+        out["g_sensitivity_subtracted"] = self.g_sensitivity_subtracted
         return out
 
 
@@ -580,17 +602,16 @@ def calibrate(
     noise_source = "dwells" if encoder_noise_arcsec is None else "option"
     encoder_noise_arcsec = motion.reading_sigma_arcsec if encoder_noise_arcsec is None else (
         encoder_noise_arcsec)  # fmt: skip
-    m = full.select_channels(channels)
     arw = _arw_rad_sqrt_s(arw_deg_sqrt_h, g, full.dt_s, seg.dwells)
-    est = _estimate(
-        m, arw, motion, float(encoder_noise_arcsec), kf_interval_s, move_block_s, prior_sigma
-    )
+    again = functools.partial(_estimate_channels, channels, arw, motion,
+                              float(encoder_noise_arcsec), kf_interval_s, move_block_s,
+                              prior_sigma)  # fmt: skip
+    g_lat = float(gravity_m_s2) if gravity_m_s2 is not None else units.normal_gravity_m_s2(lat)
+    est, gsens = _g_sensitivity(again, full, g, (a_deg, b_deg), seg.dwells, arw, lat, g_lat)
     msgs = list(_diagnostics(est, seg.n_positions))
-    acc_est, g_local = None, None
+    acc_est, g_local = None, (g_lat if accel_columns is not None else None)
     if accel_columns is not None:
-        g_local = float(gravity_m_s2) if gravity_m_s2 is not None else (
-            units.normal_gravity_m_s2(lat))  # fmt: skip
-        acc_est = _accel_triad(rec, accel_columns, accel_unit, a_deg, b_deg, seg.dwells, g_local)
+        acc_est = _accel_triad(rec, accel_columns, accel_unit, a_deg, b_deg, seg.dwells, g_lat)
         msgs.extend(_accel_diagnostics(acc_est))
     msgs.extend(_judge(est, acc_est, str(rec.name), (alpha_column, alpha_offset_deg)))
     t_mean, t_span = _soak_temperature(rec, temperature_column)
@@ -609,7 +630,64 @@ def calibrate(
         encoder_noise_arcsec=float(encoder_noise_arcsec), encoder_noise_source=noise_source,
         encoder_jitter_arcsec=motion.noise_arcsec, encoder_quantum_deg=motion.quantum_deg,
         accel=acc_est, gravity_m_s2=g_local, temperature_c=t_mean, temperature_span_c=t_span,
+        g_sensitivity=gsens[0], g_sensitivity_note=gsens[1], g_sensitivity_subtracted=gsens[2],
     )  # fmt: skip
+
+
+ISOTROPIC_NOTE = (
+    "the g-sensitivity is c·I alone (c = {c:.3g} ± {s:.2g} °/h/g): what a vertical earth "
+    "rate off by c gives (a latitude of the wrong sign), so it is not taken off the moves; "
+    "check the latitude"
+)
+"""Why an isotropic ``A`` (:func:`.gsens.isotropic_part`) is reported but not subtracted."""
+
+
+def _estimate_channels(
+    channels: int,
+    arw: FloatArray,
+    motion: schedule.Motion,
+    encoder_noise_arcsec: float,
+    kf_interval_s: float,
+    move_block_s: float,
+    prior_sigma: tuple[float, float, float],
+    m: model.IntervalModel,
+) -> _Estimates:
+    """:func:`_estimate` on the model's first ``channels`` channels."""
+    return _estimate(m.select_channels(channels), arw, motion, encoder_noise_arcsec,
+                     kf_interval_s, move_block_s, prior_sigma)  # fmt: skip
+
+
+def _g_sensitivity(
+    again: Callable[[model.IntervalModel], _Estimates],
+    full: model.IntervalModel,
+    g: FloatArray,
+    angles_deg: tuple[FloatArray, FloatArray],
+    dwells: Sequence[schedule.Dwell],
+    arw: FloatArray,
+    lat: float,
+    g_m_s2: float,
+) -> tuple[_Estimates, tuple[GSensitivity | None, str | None, bool]]:
+    """The run estimated (``again(full)``), then the gyro's g-sensitivity from the dwells
+    (:mod:`.gsens`) with its E; when an element is significant, taken off the moves, the run
+    estimated again and ``A`` found again with the new E.  The estimates, and (A or None,
+    why not, subtracted)."""
+    est = again(full)
+
+    def fit(e: _Estimates) -> GSensitivity:
+        return gsens_mod.dwell_g_sensitivity(g, full.dt_s, *angles_deg, dwells, e.kf.theta,
+                                             arw, lat, g_m_s2)  # fmt: skip
+
+    try:
+        gs = fit(est)
+    except DesignError as exc:
+        return est, (None, str(exc), False)
+    iso = gsens_mod.isotropic_part(gs)
+    if iso is not None:
+        return est, (gs, ISOTROPIC_NOTE.format(c=iso[0], s=iso[1]), False)
+    if not bool(np.any(gs.significant)):
+        return est, (gs, None, False)
+    est = again(gsens_mod.subtract_from_model(full, gs.matrix_deg_h_g, *angles_deg, g_m_s2))
+    return est, (fit(est), None, True)
 
 
 def _warned(msgs: list[str], name: str) -> list[str]:

@@ -25,6 +25,7 @@ from thermocal.defaults import MAX_SIMULATED_SAMPLES
 from thermocal.errors import ParameterError
 from thermocal.recording import Metadata, Recording
 from thermocal.turntable import kinematics, model
+from thermocal.turntable.gsens import specific_force_g
 from thermocal.turntable.schedule import POSITIONS_16, build_schedule
 
 FloatArray = npt.NDArray[np.float64]
@@ -151,6 +152,7 @@ def simulate_turntable16(
     alpha0_deg: float = 0.0,
     beta0_deg: float = 0.0,
     positions_deg: tuple[tuple[float, float], ...] = POSITIONS_16,
+    g_sensitivity_deg_h_g: npt.ArrayLike | None = None,
 ) -> tuple[Recording, dict[str, Any]]:
     r"""Simulate a 16-position turntable run with known truth.
 
@@ -176,6 +178,11 @@ def simulate_turntable16(
         Encoder readings at the schedule's zero [°] (default 0).
     positions_deg : tuple of (float, float), optional
         The (α, β) positions [°] (default the sixteen of the source).
+    g_sensitivity_deg_h_g : array_like, shape (3, 3), optional
+        The gyro's sensitivity to specific force ``A`` [°/h per g] (row the gyro axis,
+        column the specific force's axis; default none): each sample reads ``A f`` more,
+        ``f`` the specific force at the interval's mid angles [g] (normal gravity at the
+        latitude over standard gravity).
 
     Returns
     -------
@@ -198,7 +205,7 @@ def simulate_turntable16(
     -----
     Each sample's gyro output, with :math:`\omega` the true body rate (table and earth):
 
-    .. math:: \omega_\mathrm{meas} = (I + E)\,\omega + b + n, \qquad
+    .. math:: \omega_\mathrm{meas} = (I + E)\,\omega + b + A f + n, \qquad
               \sigma_n = \mathrm{ARW} / \sqrt{\tau}
 
     References
@@ -215,26 +222,46 @@ def simulate_turntable16(
                            positions_deg=positions_deg)  # fmt: skip
     tau = 1.0 / rate_hz
     n, t, a_deg, b_deg, omega_true = _sampled_motion(sched, rate_hz, latitude_deg)
-    e_mat = tr.error_matrix
-    bias = np.asarray(tr.bias_deg_h) * units.DH_TO_RS
-    arw_rad_sqrt_s = arw_deg_sqrt_h * units.DEG_TO_RAD / np.sqrt(units.SECONDS_PER_HOUR)
-    noise = rng.standard_normal((n, 3)) * (arw_rad_sqrt_s / np.sqrt(tau))
-    omega_meas = omega_true @ (np.eye(3) + e_mat).T + bias + noise
+    a_sens = np.zeros((3, 3)) if g_sensitivity_deg_h_g is None else (
+        np.asarray(g_sensitivity_deg_h_g, dtype=np.float64).reshape(3, 3))  # fmt: skip
+    omega_meas = _gyro16(omega_true, tr, a_sens, (a_deg, b_deg), latitude_deg, rng,
+                         (arw_deg_sqrt_h, tau))  # fmt: skip
     enc_sigma_deg = encoder_noise_arcsec * units.ARCSEC_TO_DEG
     a_enc = a_deg + rng.standard_normal(n) * enc_sigma_deg
     b_enc = b_deg + rng.standard_normal(n) * enc_sigma_deg
     rec = _recording16(t, omega_meas * units.RAD_TO_DEG, a_enc, b_enc, tau, latitude_deg, seed)
-    settings = {
-        "latitude_deg": latitude_deg,
-        "seed": seed,
-        "rate_hz": rate_hz,
-        "dwell_s": dwell_s,
-        "move_rate_deg_s": move_rate_deg_s,
-        "arw_deg_sqrt_h": arw_deg_sqrt_h,
-        "encoder_noise_arcsec": encoder_noise_arcsec,
-        "duration_s": float(t[-1]),
-    }
+    settings = {"latitude_deg": latitude_deg, "seed": seed, "rate_hz": rate_hz,
+                "dwell_s": dwell_s, "move_rate_deg_s": move_rate_deg_s,
+                "arw_deg_sqrt_h": arw_deg_sqrt_h, "encoder_noise_arcsec": encoder_noise_arcsec,
+                "duration_s": float(t[-1]), "g_sensitivity_deg_h_g": a_sens.tolist()}  # fmt: skip
     return rec, _truth16(tr, settings)
+
+
+def _gyro16(
+    omega_true: FloatArray,
+    tr: TurntableTruth,
+    a_sens: FloatArray,
+    angles_deg: tuple[FloatArray, FloatArray],
+    latitude_deg: float,
+    rng: np.random.Generator,
+    arw_tau: tuple[float, float],
+) -> FloatArray:
+    """The gyro outputs [rad/s] of :func:`simulate_turntable16`: ``(I + E) ω + b + n`` (the
+    noise drawn first, σ = ARW/√τ from ``arw_tau`` = (ARW [°/√h], τ [s])) plus ``A f``."""
+    n = omega_true.shape[0]
+    arw_rad_sqrt_s = arw_tau[0] * units.DEG_TO_RAD / np.sqrt(units.SECONDS_PER_HOUR)
+    noise = rng.standard_normal((n, 3)) * (arw_rad_sqrt_s / np.sqrt(arw_tau[1]))
+    bias = np.asarray(tr.bias_deg_h) * units.DH_TO_RS
+    out: FloatArray = omega_true @ (np.eye(3) + tr.error_matrix).T + bias + noise
+    out += _specific_force_g(*angles_deg, latitude_deg) @ a_sens.T * units.DH_TO_RS
+    return out
+
+
+def _specific_force_g(a_deg: FloatArray, b_deg: FloatArray, latitude_deg: float) -> FloatArray:
+    """The specific force [g] at each interval's mid angles (row 0 at rest), normal gravity."""
+    a_mid = 0.5 * (a_deg + np.concatenate([a_deg[:1], a_deg[:-1]]))
+    b_mid = 0.5 * (b_deg + np.concatenate([b_deg[:1], b_deg[:-1]]))
+    return specific_force_g(a_mid, b_mid, units.normal_gravity_m_s2(latitude_deg))
 
 
 def _recording16(
