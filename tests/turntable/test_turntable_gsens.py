@@ -207,3 +207,35 @@ def test_runs_over_temperature_state_each_runs_sensitivity(tmp_path: Path) -> No
     assert all("none beyond 3σ" in ln for ln in lines), lines
     runs = json.loads(js.getvalue())["runs"]
     assert [np.shape(r["g_sensitivity"]["matrix"]) for r in runs] == [(3, 3)] * 3
+
+
+def _soak_calibration(tmp_path: Path, a_true: np.ndarray | None) -> dict:
+    from thermocal.turntable.simulate import simulate_turntable_thermal
+
+    files = []
+    for rec, truth in simulate_turntable_thermal(
+        seed=3, soaks_c=(-20.0, 20.0, 60.0), g_sensitivity_deg_h_g=a_true
+    ):
+        if not truth["held_out"]:
+            files.append(tmp_path / f"{truth['label']}.parquet")
+            write_recording(rec, files[-1])
+    out = tmp_path / "cal.json"
+    args = ["turntable", *map(str, files), "--temps", "T_imu", "--order", "1", "-o", str(out)]
+    with contextlib.redirect_stdout(io.StringIO()):
+        assert main(args) == 0
+    gyro = [t for t in json.loads(out.read_text())["triads"] if t["name"] == "gyro"]
+    return gyro[0]
+
+
+def test_soaks_store_the_pooled_sensitivity_in_the_calibration(tmp_path: Path) -> None:
+    """Three soaks of a gyro with a known A (°/h/g, constant in temperature): the
+    calibration file's gyro triad holds A in its own unit per g (°/s/g here) within 3σ of
+    the truth, so that ``compensate`` takes A f off; without A nothing is stored."""
+    got = _soak_calibration(tmp_path, A_TRUE)
+    assert got["g_sensitivity_unit"] == "deg/s/g"
+    a = np.asarray(got["g_sensitivity"]) * 3600.0  # °/s/g → °/h/g, written here
+    sig = np.asarray(got["g_sensitivity_sigma"]) * 3600.0
+    assert np.all(sig > 0) and np.all(sig < 0.05), sig
+    assert np.all(np.abs(a - A_TRUE) < 3.0 * sig), (a - A_TRUE) / sig
+    (tmp_path / "none").mkdir()
+    assert "g_sensitivity" not in _soak_calibration(tmp_path / "none", None)

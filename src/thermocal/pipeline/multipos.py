@@ -677,8 +677,7 @@ def _g_sensitivity(
     # does that, SessionResult.g_sensitivity_subtracted) has its bias at zero force already:
     # moved only where that was not done
     return stored, [
-        r if getattr(r.result, "g_sensitivity_subtracted", False) else _zero_force_bias(r, a, sig)
-        for r in runs
+        r if r.result.g_sensitivity_subtracted else _zero_force_bias(r, a, sig) for r in runs
     ]
 
 

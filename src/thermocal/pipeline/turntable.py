@@ -504,7 +504,7 @@ def thermal_runs(
         tref_c=tref_c, order=order,
     )  # fmt: skip
     triads = [Triad("gyro", opts.gyro, gyro_unit, temps, gyro_model, rig, latitude, record)]
-    # TODO(lead, after z3-gsens-apply): Triad(..., g_sensitivity=, g_sensitivity_sigma=, g_sensitivity_unit=f"{gyro_unit}/g") from thermocal.turntable.gsens.pooled_g_sensitivity([r.g_sensitivity for _f, r in runs]) (°/h/g: × units.convert(1.0, "deg/h", gyro_unit) per g)  # noqa: E501
+    triads[0] = _with_g_sensitivity(triads[0], [r for _f, r in runs], gyro_unit)
     accel_model = None
     if opts.accel is not None:
         accel_model = _thermal.fit_triad(
@@ -522,6 +522,25 @@ def thermal_runs(
                   "order")  # fmt: skip
     save_calibration(cal, output)
     return ThermalRunsResult(output, tuple(runs), gyro_model, accel_model, record)
+
+
+def _with_g_sensitivity(gyro: Any, runs: Sequence[TurntableResult], gyro_unit: str) -> Any:
+    """The gyro triad carrying the runs' pooled g-sensitivity when every run took its
+    ``A f`` off before its fit (its bias is then the bias at zero specific force, as
+    ``compensate`` expects); unchanged otherwise (``A`` reported, not stored)."""
+    from dataclasses import replace as _replace
+
+    from thermocal.turntable.gsens import pooled_g_sensitivity
+
+    if not runs or not all(r.g_sensitivity_subtracted for r in runs):
+        return gyro
+    pooled = pooled_g_sensitivity([r.g_sensitivity for r in runs])
+    if pooled is None:
+        return gyro
+    to_unit = float(units.convert(np.array([1.0]), "deg/h", gyro_unit)[0])
+    return _replace(
+        gyro, g_sensitivity=pooled[0] * to_unit, g_sensitivity_sigma=pooled[1] * to_unit
+    )
 
 
 def _soak_runs(

@@ -271,18 +271,12 @@ def pooled_g_sensitivity(
       Theory*, Prentice Hall, 1993, ch. 6 (the best linear unbiased estimator of a common
       mean: the inverse-variance weighted mean).
     """
+    from thermocal.multipos.gsens import combine_g_sensitivity
+
     used = [e for e in estimates if e is not None]
     if not used:
         return None
-    a = np.stack([e.matrix_deg_h_g for e in used])
-    w = 1.0 / np.stack([e.sigma_deg_h_g for e in used]) ** 2
-    mean = (w * a).sum(axis=0) / w.sum(axis=0)
-    var = 1.0 / w.sum(axis=0)
-    if len(used) > 1:
-        chi = (w * (a - mean) ** 2).sum(axis=0) / (len(used) - 1)
-        var = var * np.maximum(chi, 1.0)
-    out: tuple[FloatArray, FloatArray] = (mean, np.sqrt(var))
-    return out
+    return combine_g_sensitivity(used)
 
 
 __all__ = [

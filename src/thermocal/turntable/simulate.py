@@ -513,6 +513,7 @@ def simulate_turntable_thermal(
     accel_noise_mg: float = 0.05,
     encoder_noise_arcsec: float = 0.0,
     drop_position: tuple[str, int] | None = None,
+    g_sensitivity_deg_h_g: npt.ArrayLike | None = None,
 ) -> list[tuple[Recording, dict[str, Any]]]:
     r"""16-position runs at several soak temperatures plus a held-out run at an unseen one,
     of a gyro and an accelerometer triad whose every parameter follows
@@ -545,6 +546,10 @@ def simulate_turntable_thermal(
         Encoder reading noise σ [″] (default 0).
     drop_position : tuple of (str, int) or None, optional
         ``(label, index)``: that run misses that position (default none).
+    g_sensitivity_deg_h_g : array_like, shape (3, 3), optional
+        The gyro's sensitivity to specific force ``A`` [°/h per g], constant in temperature
+        (default none): :math:`A f` added to the gyro, ``f`` the true specific force in g
+        (:math:`g_0` = 9.80665 m/s²).
 
     Returns
     -------
@@ -583,6 +588,9 @@ def simulate_turntable_thermal(
         gyro, acc = _thermal_outputs(
             omega_true, f_true, temp, rng, arw / np.sqrt(tau), accel_noise_mg
         )
+        if g_sensitivity_deg_h_g is not None:
+            a_sens = np.asarray(g_sensitivity_deg_h_g, dtype=np.float64).reshape(3, 3)
+            gyro = gyro + (f_true / units.STANDARD_GRAVITY_M_S2) @ a_sens.T * units.DH_TO_RS
         enc = encoder_noise_arcsec * units.ARCSEC_TO_DEG
         alpha = np.mod(a_deg + rng.standard_normal(n) * enc, 360.0)
         beta = np.mod(b_deg + rng.standard_normal(n) * enc, 360.0)
