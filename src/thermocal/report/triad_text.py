@@ -107,7 +107,11 @@ def g_sensitivity_line(run: dict[str, Any], what: str = "poses") -> str | None:
     if not found:
         worst = max(max(row) for row in gs["matrix_sigma"])
         return head + f"none beyond 3σ (σ ≤ {fmt(worst, 2)})"
-    done = "; taken off the rotations before the fit" if g.get("g_sensitivity_subtracted") else ""
+    done = (
+        "; taken off the rotations before the fit"
+        if g.get("g_sensitivity_subtracted")
+        else "; not compensated by this calibration"
+    )
     why = f"; {g['g_sensitivity_note']}" if g.get("g_sensitivity_note") else ""
     return head + "; ".join(found) + f" (beyond 3σ{done}{why})"
 
