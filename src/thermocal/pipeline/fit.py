@@ -41,6 +41,7 @@ from thermocal.errors import (
     ThermocalInputError,
 )
 from thermocal.families import MAX_ORDER, MAX_TERMS
+from thermocal.pipeline.fit_columns import run_in_blocks
 from thermocal.pipeline.messages import warning_text
 from thermocal.pipeline.options import FitOptions
 from thermocal.pipeline.reading import check_recording
@@ -388,9 +389,13 @@ def _prepare_channel(
             )  # fmt: skip
             if g_in.record is not None:  # export-params reads whether it was measured
                 first_inputs["known_input"]["gravity"] = g_in.record
-        run = _rundata.RunData.from_recording(
-            rec, signal, list(temps) if temps else None, known_input=ki, temperature_unit="auto"
-        )
+        if spec.family == "poly":  # its passes go by blocks: temperatures read as they go
+            run = run_in_blocks(rec, signal, list(temps) if temps else None, ki, validated=True)
+        else:
+            run = _rundata.RunData.from_recording(
+                rec, signal, list(temps) if temps else None, known_input=ki,
+                temperature_unit="auto",
+            )  # fmt: skip
         run = dataclasses.replace(run, name=path.name)
         if temp_names is None:
             temp_names = run.temp_names
@@ -854,8 +859,11 @@ def fit_files(paths: Sequence[Path], options: FitOptions, output: Path) -> FitRe
     from thermocal.readers.dispatch import read_recording
 
     read = o.read_options
-    loaded = [
-        (path, check_recording(read_recording(path, read), read))
+    loaded = [  # poly: temperature columns read as the fit needs them, not held whole
+        (
+            path,
+            check_recording(read_recording(path, read, columns_on_demand=o.model == "poly"), read),
+        )
         for path in station_sensor_paths(paths, o.topic)
     ]
     if o.tref is not None and o.model != "poly":
