@@ -41,7 +41,7 @@ from thermocal.errors import (
     ThermocalInputError,
 )
 from thermocal.families import MAX_ORDER, MAX_TERMS
-from thermocal.pipeline.fit_columns import run_in_blocks
+from thermocal.pipeline.fit_columns import read_by_blocks, run_in_blocks
 from thermocal.pipeline.messages import warning_text
 from thermocal.pipeline.options import FitOptions
 from thermocal.pipeline.reading import check_recording
@@ -856,16 +856,7 @@ def fit_files(paths: Sequence[Path], options: FitOptions, output: Path) -> FitRe
     family_options = _check_options(paths, o, output)
     names = list(o.signals or ())
     g_local = _local_gravity(o.gravity_axis, o.gravity, o.latitude)
-    from thermocal.readers.dispatch import read_recording
-
-    read = o.read_options
-    loaded = [  # poly: temperature columns read as the fit needs them, not held whole
-        (
-            path,
-            check_recording(read_recording(path, read, columns_on_demand=o.model == "poly"), read),
-        )
-        for path in station_sensor_paths(paths, o.topic)
-    ]
+    loaded = [(path, _read_run(path, o)) for path in station_sensor_paths(paths, o.topic)]
     if o.tref is not None and o.model != "poly":
         raise ParameterError(
             "tref",
@@ -910,6 +901,17 @@ def fit_files(paths: Sequence[Path], options: FitOptions, output: Path) -> FitRe
         for name, est, res, n in fitted
     )
     return FitResult(output, channels, True)
+
+
+def _read_run(path: Path, o: FitOptions) -> _recording.Recording:
+    """One run read and checked (:func:`check_recording`); a long Parquet file fitted with
+    ``poly`` read with its columns on demand, its temperatures read as the checks and the
+    fit's passes need them (:mod:`thermocal.pipeline.fit_columns`)."""
+    from thermocal.readers.dispatch import read_recording
+
+    read = o.read_options
+    blocks = o.model == "poly" and read_by_blocks(path)
+    return check_recording(read_recording(path, read, columns_on_demand=blocks), read)
 
 
 def _heater_holds(

@@ -35,6 +35,11 @@ if TYPE_CHECKING:
     from thermocal.models.rundata import RunData
     from thermocal.recording import Recording
 
+MIN_ROWS_BY_BLOCKS = 1 << 21
+"""Rows from which a fit reads a Parquet file's columns on demand (below, four temperature
+columns are at most 64 MB held whole, and reading them again as the fit goes costs more
+than they weigh)."""
+
 MAX_GROUP_ROWS = 1 << 21
 """Largest row group [rows] read block by block: beyond it one group's temperatures are
 as large as holding them whole would be on a short file, and they are held whole."""
@@ -208,6 +213,33 @@ class TemperatureBlocks:
         return self.shape[0]
 
 
+def read_by_blocks(path: Path) -> bool:
+    """Whether a fit reads ``path``'s columns on demand (its temperatures then by
+    :class:`TemperatureBlocks`): a Parquet file (by its suffix, as the reader dispatches it)
+    of at least :data:`MIN_ROWS_BY_BLOCKS` rows.  Anything the footer does not say (not
+    Parquet, unreadable) is ``False``: the reader then reads it, or says what is wrong.
+
+    Parameters
+    ----------
+    path : Path
+        The file given to the fit.
+
+    Returns
+    -------
+    bool
+    """
+    from thermocal.readers.formats import file_kind
+
+    if file_kind(path) != "parquet" or not path.is_file():
+        return False
+    import pyarrow.parquet as pq
+
+    try:
+        return int(pq.read_metadata(path).num_rows) >= MIN_ROWS_BY_BLOCKS
+    except (OSError, ValueError):  # pyarrow's ArrowInvalid is a ValueError
+        return False
+
+
 def temperature_blocks(rec: Recording, names: Sequence[str]) -> TemperatureBlocks | None:
     """The temperatures ``names`` of ``rec`` read block by block, where that changes no value
     (module docstring): ``rec`` read on demand from a Parquet file, every column the file's
@@ -301,4 +333,11 @@ def run_in_blocks(
     )
 
 
-__all__ = ["MAX_GROUP_ROWS", "TemperatureBlocks", "run_in_blocks", "temperature_blocks"]
+__all__ = [
+    "MAX_GROUP_ROWS",
+    "MIN_ROWS_BY_BLOCKS",
+    "TemperatureBlocks",
+    "read_by_blocks",
+    "run_in_blocks",
+    "temperature_blocks",
+]
