@@ -4149,6 +4149,46 @@ MUTANTS: tuple[Mutant, ...] = (
         _t("quantiles"),
         "the Newton steps' bracket kept on the wrong side of the root",
     ),
+    Mutant(
+        "fitcols-rows-group-end",
+        P + "pipeline/fit_columns.py",
+        "            stop = min(b, g1)",
+        "            stop = min(b, g1 - 1)",
+        _t("fit_columns"),
+        "a block of rows spanning row groups takes each group's last row from the next",
+    ),
+    Mutant(
+        "fitcols-pick-group",
+        P + "pipeline/fit_columns.py",
+        "        groups = np.searchsorted(self._starts, idx, side=\"right\") - 1",
+        "        groups = np.searchsorted(self._starts, idx, side=\"left\") - 1",
+        _t("fit_columns"),
+        "a row picked at a row group's first row looked for in the group before",
+    ),
+    Mutant(
+        "fitcols-min-rows",
+        P + "pipeline/fit_columns.py",
+        "        return int(pq.read_metadata(path).num_rows) >= MIN_ROWS_BY_BLOCKS",
+        "        return int(pq.read_metadata(path).num_rows) > MIN_ROWS_BY_BLOCKS",
+        _t("fit_columns"),
+        "a file of exactly MIN_ROWS_BY_BLOCKS rows held whole",
+    ),
+    Mutant(
+        "adequacy-scratch-nan",
+        P + "adequacy.py",
+        "    t = temps if scratch and all_finite(temps) else temps[np.isfinite(temps)]",
+        "    t = temps if scratch else temps[np.isfinite(temps)]",
+        _t("adequacy"),
+        "a temperature column of the caller's own judged with its NaN kept",
+    ),
+    Mutant(
+        "offsets-range-overwrite",
+        P + "models/fitting.py",
+        "overwrite_input=not isinstance(temps_c, np.ndarray))",
+        "overwrite_input=True)",
+        _t("fit_columns"),
+        "the runs' central ranges partition a run's own temperature column in place",
+    ),
 )
 
 

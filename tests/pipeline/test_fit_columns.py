@@ -146,11 +146,12 @@ def test_four_temperature_fit_equals_the_whole_read(
         return made[-1]
 
     monkeypatch.setattr(fit_columns, "temperature_blocks", spy)
-    monkeypatch.setattr(fit_columns, "MIN_ROWS_BY_BLOCKS", 70_000)  # these files by blocks
+    monkeypatch.setattr(fit_columns, "MIN_ROWS_BY_BLOCKS", 70_001)  # these files by blocks
     got, got_w = _fit(paths, tmp_path / "blocks.json", signals, **params)
     assert made and all(isinstance(b, TemperatureBlocks) for b in made)  # read by blocks
     monkeypatch.undo()
     assert not fit_columns.read_by_blocks(paths[0])  # 70 001 rows: read whole by default
+    assert not fit_columns.read_by_blocks(tmp_path / "absent.parquet")
     whole_read = dispatch.read_recording
 
     def whole(*a: Any, **k: Any) -> Any:
