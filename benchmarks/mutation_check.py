@@ -4160,8 +4160,8 @@ MUTANTS: tuple[Mutant, ...] = (
     Mutant(
         "fitcols-pick-group",
         P + "pipeline/fit_columns.py",
-        "        groups = np.searchsorted(self._starts, idx, side=\"right\") - 1",
-        "        groups = np.searchsorted(self._starts, idx, side=\"left\") - 1",
+        '        groups = np.searchsorted(self._starts, idx, side="right") - 1',
+        '        groups = np.searchsorted(self._starts, idx, side="left") - 1',
         _t("fit_columns"),
         "a row picked at a row group's first row looked for in the group before",
     ),
@@ -4188,6 +4188,22 @@ MUTANTS: tuple[Mutant, ...] = (
         "overwrite_input=True)",
         _t("fit_columns"),
         "the runs' central ranges partition a run's own temperature column in place",
+    ),
+    Mutant(
+        "stillness-equal-block-index",
+        P + "adequacy.py",
+        "    inv = picked // counts[0] if equal else",
+        "    inv = (picked + 1) // counts[0] if equal else",
+        _t("adequacy_medians"),
+        "the noise of a regular record measured about the next block's median",
+    ),
+    Mutant(
+        "stillness-mad-in-place",
+        P + "adequacy.py",
+        "np.median(np.abs(dev, out=dev), overwrite_input=True)",
+        "np.median(np.abs(v[::every, j], out=dev), overwrite_input=True)",
+        _t("adequacy_medians"),
+        "the noise taken from the values, not their deviations from the block medians",
     ),
 )
 

@@ -672,8 +672,10 @@ def _block_stats(
     med = np.empty((starts.size, m))
     sigma = np.empty(m)
     every = max(1, idx.size // SIGMA_SAMPLES)  # the noise from an even subsample
-    inv = np.searchsorted(starts, np.arange(0, idx.size, every), side="right") - 1
     equal = bool(np.all(counts == counts[0]))
+    picked = np.arange(0, idx.size, every)
+    # each picked sample's block: blocks of one length c start at multiples of c
+    inv = picked // counts[0] if equal else np.searchsorted(starts, picked, side="right") - 1
     if not equal:  # each block a row, padded with NaN (sorted last, as in the block alone)
         rows = np.repeat(np.arange(starts.size), counts)
         at = (rows, np.arange(idx.size) - starts[rows])
@@ -688,8 +690,8 @@ def _block_stats(
             block.sort(axis=1)
             every_block = np.arange(starts.size)
             med[:, j] = 0.5 * (block[every_block, lo_i] + block[every_block, hi_i])
-        dev = v[::every, j] - med[inv, j]
-        sigma[j] = 1.4826 * float(np.median(np.abs(dev)))
+        dev = v[::every, j] - med[inv, j]  # its own: |dev| in place, partitioned in place
+        sigma[j] = 1.4826 * float(np.median(np.abs(dev, out=dev), overwrite_input=True))
     return time_s[0] + idx[starts] * block_s, counts.astype(np.float64), med, sigma
 
 
@@ -873,7 +875,8 @@ def _stillness(
         t, v = t[ok], v[ok]
     if t.size < 20:
         return Motion(0.0, 0.0, floor)
-    dt = float(np.median(np.diff(t[:100_001])))  # the sample interval, from the start
+    # the sample interval, from the start (the steps are its own: partitioned in place)
+    dt = float(np.median(np.diff(t[:100_001]), overwrite_input=True))
     block_s = max(STILL_BLOCK_S, 10.0 * dt)
     tb, cnt, meds, sigma = _block_stats(t, v, block_s)
     centre, before, after = _window_medians(tb, meds, max(STILL_WINDOW_S, 30.0 * block_s))
