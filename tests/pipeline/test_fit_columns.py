@@ -152,6 +152,9 @@ def test_four_temperature_fit_equals_the_whole_read(
     monkeypatch.undo()
     assert not fit_columns.read_by_blocks(paths[0])  # 70 001 rows: read whole by default
     assert not fit_columns.read_by_blocks(tmp_path / "absent.parquet")
+    assert not fit_columns.read_by_blocks(tmp_path)  # a folder (a station's recording)
+    (tmp_path / "notes.xyz").write_text("x")
+    assert not fit_columns.read_by_blocks(tmp_path / "notes.xyz")
     whole_read = dispatch.read_recording
 
     def whole(*a: Any, **k: Any) -> Any:

@@ -228,9 +228,13 @@ def read_by_blocks(path: Path) -> bool:
     -------
     bool
     """
+    from thermocal.errors import ThermocalInputError
     from thermocal.readers.formats import file_kind
 
-    if file_kind(path) != "parquet" or not path.is_file():
+    try:  # a folder (a station's recording) or a name no format claims: read as before
+        if not path.is_file() or file_kind(path) != "parquet":
+            return False
+    except ThermocalInputError:
         return False
     import pyarrow.parquet as pq
 
