@@ -1,5 +1,5 @@
 """A fit's temperature columns read from their Parquet file by row groups, as the fit's
-passes go, instead of held whole (``thermocal fit``, issue 41 item 3).
+passes go, instead of held whole (``thermocal fit`` on a long record).
 
 A ``poly`` fit goes through its runs in blocks of rows (the scaling sample, the design's
 reduction, the residuals: :mod:`thermocal.models.poly_fit`) and its checks look at one
