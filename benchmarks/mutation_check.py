@@ -4205,6 +4205,14 @@ MUTANTS: tuple[Mutant, ...] = (
         _t("adequacy_medians"),
         "the noise taken from the values, not their deviations from the block medians",
     ),
+    Mutant(
+        "thermometer-distinct-count",
+        P + "thermometer.py",
+        "        return None, int(u.size)",
+        "        return None, int(values.size)",
+        _t("thermometer"),
+        "a continuous reading's levels counted as its samples, not its distinct values",
+    ),
 )
 
 
