@@ -4213,6 +4213,14 @@ MUTANTS: tuple[Mutant, ...] = (
         _t("thermometer"),
         "a continuous reading's levels counted as its samples, not its distinct values",
     ),
+    Mutant(
+        "fitcols-same-columns-path",
+        P + "pipeline/fit_columns.py",
+        "            and self.path == other.path\n",
+        "",
+        _t("fit_columns"),
+        "the same column names of another file taken for the same temperatures",
+    ),
 )
 
 

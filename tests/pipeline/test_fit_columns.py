@@ -147,6 +147,11 @@ def test_four_temperature_fit_equals_the_whole_read(
 
     monkeypatch.setattr(fit_columns, "temperature_blocks", spy)
     monkeypatch.setattr(fit_columns, "MIN_ROWS_BY_BLOCKS", 70_001)  # these files by blocks
+
+    def whole_array(*a: Any, **k: Any) -> Any:
+        raise AssertionError("the temperatures were read whole")
+
+    monkeypatch.setattr(TemperatureBlocks, "__array__", whole_array)  # never all at once
     got, got_w = _fit(paths, tmp_path / "blocks.json", signals, **params)
     assert made and all(isinstance(b, TemperatureBlocks) for b in made)  # read by blocks
     monkeypatch.undo()
@@ -184,3 +189,17 @@ def test_a_reconstructed_or_converted_column_is_held_whole(tmp_path: Path) -> No
     assert fit_columns.temperature_blocks(given, names) is None
     whole = read_recording(path)
     assert fit_columns.temperature_blocks(whole, names) is None
+
+
+def test_blocks_are_the_same_columns_only_of_the_same_file(tmp_path: Path) -> None:
+    """Two channels of one run share its temperatures without reading them to compare;
+    the same names of another file (equal shape) are other columns."""
+    a = _write(tmp_path / "a.parquet", 3000, 1000, seed=1)
+    b = _write(tmp_path / "b.parquet", 3000, 1000, seed=1)
+    names = [f"T{k + 1}" for k in range(4)]
+    one = TemperatureBlocks(pq.ParquetFile(a), names, a)
+    assert one.same_columns(TemperatureBlocks(pq.ParquetFile(a), names, a))
+    assert not one.same_columns(TemperatureBlocks(pq.ParquetFile(b), names, b))
+    assert not one.same_columns(TemperatureBlocks(pq.ParquetFile(a), names[::-1], a))
+    assert not TemperatureBlocks(pq.ParquetFile(a), names).same_columns(one)
+    assert not one.same_columns(np.asarray(one))

@@ -41,7 +41,7 @@ from thermocal.errors import (
     ThermocalInputError,
 )
 from thermocal.families import MAX_ORDER, MAX_TERMS
-from thermocal.pipeline.fit_columns import read_by_blocks, run_in_blocks
+from thermocal.pipeline.fit_columns import TemperatureBlocks, read_by_blocks, run_in_blocks
 from thermocal.pipeline.messages import warning_text
 from thermocal.pipeline.options import FitOptions
 from thermocal.pipeline.reading import check_recording
@@ -341,12 +341,20 @@ def _fit_channels(
 
 def _share_inputs(preps: list[_Prepared]) -> None:
     """Give every channel's runs the first channel's time and temperature arrays when they
-    are equal (one copy in memory, and :func:`fit_shared` sees one design)."""
+    are equal (one copy in memory, and :func:`fit_shared` sees one design); temperatures
+    read by blocks are the same when they are the same file's columns (never read whole
+    to compare them)."""
     first = preps[0].runs
     for p in preps[1:]:
         for i, r in enumerate(p.runs):
-            f = first[i]
-            if r.temps_c is not f.temps_c and np.array_equal(r.temps_c, f.temps_c):
+            f, mine = first[i], r.temps_c
+            if mine is f.temps_c:
+                continue
+            if (
+                mine.same_columns(f.temps_c)
+                if isinstance(mine, TemperatureBlocks)
+                else np.array_equal(mine, f.temps_c)
+            ):
                 p.runs[i] = dataclasses.replace(r, temps_c=f.temps_c)
 
 

@@ -57,6 +57,8 @@ class TemperatureBlocks:
         The open file.
     names : sequence of str
         The temperature columns, in the fit's order (integer or floating point).
+    path : Path, optional
+        The file, to tell two stand-ins of the same columns (:meth:`same_columns`).
 
     Examples
     --------
@@ -73,9 +75,12 @@ class TemperatureBlocks:
     ndim = 2
     dtype = np.dtype(np.float64)
 
-    def __init__(self, source: pq.ParquetFile, names: Sequence[str]) -> None:
+    def __init__(
+        self, source: pq.ParquetFile, names: Sequence[str], path: Path | None = None
+    ) -> None:
         self._pf = source
         self._names = tuple(names)
+        self.path = path
         meta = source.metadata
         sizes = [meta.row_group(i).num_rows for i in range(meta.num_row_groups)]
         self._starts = np.concatenate([[0], np.cumsum(sizes, dtype=np.int64)])
@@ -86,6 +91,27 @@ class TemperatureBlocks:
     def largest_group(self) -> int:
         """Rows of the file's largest row group."""
         return int(np.diff(self._starts).max()) if self._starts.size > 1 else 0
+
+    def same_columns(self, other: object) -> bool:
+        """Whether ``other`` stands in for the same columns of the same file (equal values
+        without reading them: the channels of one run share them).
+
+        Parameters
+        ----------
+        other : object
+            Another run's temperatures.
+
+        Returns
+        -------
+        bool
+        """
+        return (
+            isinstance(other, TemperatureBlocks)
+            and self.path is not None
+            and self.path == other.path
+            and self._names == other._names
+            and self.shape == other.shape
+        )
 
     def release(self) -> None:
         """Let go of the row group kept from the last block."""
@@ -276,7 +302,8 @@ def temperature_blocks(rec: Recording, names: Sequence[str]) -> TemperatureBlock
             return None
     import pyarrow.parquet as pq
 
-    blocks = TemperatureBlocks(pq.ParquetFile(Path(rec.source)), names)
+    path = Path(rec.source)
+    blocks = TemperatureBlocks(pq.ParquetFile(path), names, path)
     if blocks.shape[0] != rec.n_samples or blocks.largest_group > MAX_GROUP_ROWS:
         return None
     return blocks
