@@ -389,7 +389,7 @@ def _range_ends_test(t: FloatArray, lo: float, hi: float, name: str) -> Adequacy
 
 
 def temperature_tests(
-    temps: FloatArray, name: str, order: int, *, unit: str = "°C"
+    temps: FloatArray, name: str, order: int, *, unit: str = "°C", scratch: bool = False
 ) -> list[AdequacyTest]:
     """Span, distinct temperatures and coverage of the ends of one temperature column.
 
@@ -403,6 +403,10 @@ def temperature_tests(
         The model's polynomial order in this column.
     unit : str, optional
         Unit of ``temps``; anything but ``"°C"`` (raw counts) is not judged.
+    scratch : bool, optional
+        ``temps`` is the caller's own array and may be reordered in place: no copy of it
+        when it is finite (the same figures: the tests do not use the order).  Default
+        ``False``.
 
     Returns
     -------
@@ -423,7 +427,8 @@ def temperature_tests(
                 f"{name}: temperatures in raw {unit} without a conversion: span not judged",
             )
         ]
-    t = temps[np.isfinite(temps)]  # a copy, reordered by the percentiles (order is not used)
+    # a copy (unless the caller's own), reordered by the percentiles (order is not used)
+    t = temps if scratch and all_finite(temps) else temps[np.isfinite(temps)]
     lo, hi = _span(t, finite_scratch=True)
     span = hi - lo if t.size else 0.0
     need = MIN_SPAN_PER_ORDER_C * max(order, 1)
@@ -667,8 +672,10 @@ def _block_stats(
     med = np.empty((starts.size, m))
     sigma = np.empty(m)
     every = max(1, idx.size // SIGMA_SAMPLES)  # the noise from an even subsample
-    inv = np.searchsorted(starts, np.arange(0, idx.size, every), side="right") - 1
     equal = bool(np.all(counts == counts[0]))
+    picked = np.arange(0, idx.size, every)
+    # each picked sample's block: blocks of one length c start at multiples of c
+    inv = picked // counts[0] if equal else np.searchsorted(starts, picked, side="right") - 1
     if not equal:  # each block a row, padded with NaN (sorted last, as in the block alone)
         rows = np.repeat(np.arange(starts.size), counts)
         at = (rows, np.arange(idx.size) - starts[rows])
@@ -683,8 +690,8 @@ def _block_stats(
             block.sort(axis=1)
             every_block = np.arange(starts.size)
             med[:, j] = 0.5 * (block[every_block, lo_i] + block[every_block, hi_i])
-        dev = v[::every, j] - med[inv, j]
-        sigma[j] = 1.4826 * float(np.median(np.abs(dev)))
+        dev = v[::every, j] - med[inv, j]  # its own: |dev| in place, partitioned in place
+        sigma[j] = 1.4826 * float(np.median(np.abs(dev, out=dev), overwrite_input=True))
     return time_s[0] + idx[starts] * block_s, counts.astype(np.float64), med, sigma
 
 
@@ -868,7 +875,8 @@ def _stillness(
         t, v = t[ok], v[ok]
     if t.size < 20:
         return Motion(0.0, 0.0, floor)
-    dt = float(np.median(np.diff(t[:100_001])))  # the sample interval, from the start
+    # the sample interval, from the start (the steps are its own: partitioned in place)
+    dt = float(np.median(np.diff(t[:100_001]), overwrite_input=True))
     block_s = max(STILL_BLOCK_S, 10.0 * dt)
     tb, cnt, meds, sigma = _block_stats(t, v, block_s)
     centre, before, after = _window_medians(tb, meds, max(STILL_WINDOW_S, 30.0 * block_s))
@@ -1077,16 +1085,18 @@ def judge(
         order = needs.order.get(tn, 0)
         if order <= 0 and tn not in needs.rate:
             continue
-        parts = [np.asarray(T, dtype=np.float64)[:, j] for T in runs_temps]
+        parts = [_column(T, j) for T in runs_temps]
         col = parts[0] if len(parts) == 1 else np.concatenate(parts)  # no copy of one run
+        own = len(parts) > 1 or not isinstance(runs_temps[0], np.ndarray)  # a new array
         if order > 0:
-            tests.extend(temperature_tests(col, tn, order, unit=temperature_unit))
+            tests.extend(temperature_tests(col, tn, order, unit=temperature_unit, scratch=own))
+        del parts, col
         if tn in needs.rate:
             rates = np.concatenate(
                 [
                     temperature_rate_c_per_min(
                         np.asarray(ts, dtype=np.float64),
-                        np.asarray(T, dtype=np.float64)[:, j],
+                        _column(T, j),
                         rate_interval_s,
                     )
                     for ts, T in zip(runs_time_s, runs_temps, strict=True)
@@ -1107,6 +1117,15 @@ def judge(
         ]
         tests.append(_worst_stillness(per_run))
     return Adequacy(tuple(tests), tuple(overrides), name)
+
+
+def _column(temps: Any, j: int) -> FloatArray:
+    """Column ``j`` of a run's ``(n, k)`` temperatures: a view of an array, or read from
+    an array-like that reads its columns when asked for (``temps[:, j]``,
+    :class:`thermocal.pipeline.fit_columns.TemperatureBlocks`) without holding them all."""
+    if isinstance(temps, np.ndarray):
+        return np.asarray(temps, dtype=np.float64)[:, j]
+    return np.asarray(temps[:, j], dtype=np.float64)
 
 
 def _worst_stillness(tests: list[AdequacyTest]) -> AdequacyTest:

@@ -115,15 +115,20 @@ class Thermometer:
 def _levels(values: FloatArray) -> tuple[FloatArray, FloatArray] | None:
     """The distinct levels and their sample counts, float noise merged; None when a group of
     merged values is wider than 10 × :data:`NOISE_C` (a fine, continuous reading)."""
+    return _levels_counted(values)[0]
+
+
+def _levels_counted(values: FloatArray) -> tuple[tuple[FloatArray, FloatArray] | None, int]:
+    """:func:`_levels`, and the number of distinct values (of the same one sort)."""
     u, counts = np.unique(values, return_counts=True)
     split = np.flatnonzero(np.diff(u) > NOISE_C) + 1
     starts = np.concatenate([[0], split])
     ends = np.concatenate([split, [u.size]])
     if np.any(u[ends - 1] - u[starts] > 10 * NOISE_C):
-        return None
+        return None, int(u.size)
     weight = np.add.reduceat(counts, starts).astype(np.float64)
     centre = np.add.reduceat(u * counts, starts) / weight
-    return centre, weight
+    return (centre, weight), int(u.size)
 
 
 def _robust_gcd(x: FloatArray, tol: float) -> float | None:
@@ -319,8 +324,8 @@ def describe_thermometer(time_s: FloatArray, temp_c: FloatArray) -> Thermometer:
     t, v = t[::stride], v[::stride]
     ok = np.isfinite(v) & np.isfinite(t)
     t, v = t[ok], v[ok]
-    found = _levels(v)
-    n_levels = int(found[0].size) if found is not None else int(np.unique(v).size)
+    found, n_distinct = _levels_counted(v)  # one sort: the levels and the distinct values
+    n_levels = int(found[0].size) if found is not None else n_distinct
     step = _lattice_of(v, found)  # v finite: its levels are found once
     period = update_period(t, v, step)
     dt = float(np.median(np.diff(t))) / stride if t.size > 1 else 0.0

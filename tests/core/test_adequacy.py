@@ -440,3 +440,41 @@ def test_fit_prints_in_the_data_unit(tmp_path: Path) -> None:
     assert d["unit"] == "deg/s" and d["model_unit"] == "deg/h"
     assert d["rms_residual"] == pytest.approx(0.05, rel=0.02)
     assert d["rms_residual_model_unit"] == pytest.approx(d["rms_residual"] * 3600.0, rel=1e-12)
+
+
+class _ColumnsWhenAsked:
+    """An (n, k) array-like that hands out a new copy of a column at each ``[:, j]`` (as
+    :class:`thermocal.pipeline.fit_columns.TemperatureBlocks` does) and refuses to be read
+    whole."""
+
+    def __init__(self, values: np.ndarray) -> None:
+        self._values, self.shape, self.ndim = values, values.shape, 2
+
+    def __getitem__(self, key: object) -> np.ndarray:
+        assert isinstance(key, tuple) and key[0] == slice(None), key
+        return self._values[:, key[1]].copy()
+
+    def __array__(self, *a: object, **k: object) -> np.ndarray:
+        raise AssertionError("read whole")
+
+
+@pytest.mark.parametrize("with_nan", [False, True])
+def test_temperatures_read_a_column_at_a_time_are_judged_as_an_array(with_nan: bool) -> None:
+    """judge() takes each run's temperatures a column at a time: an array-like that reads
+    its columns when asked is judged, test for test, as the array itself (the span's
+    percentiles, distinct bins and range ends by a formula written here), NaN dropped."""
+    t = np.arange(0.0, 20_000.0, 1.0)
+    temps = np.column_stack([10.0 + 30.0 * t / t[-1], 20.0 + 5.0 * np.sin(t / 900.0)])
+    if with_nan:
+        temps[::97, 0] = np.nan
+    needs = Needs({"T1": 2, "T2": 1}, 6)
+    want = judge(needs, [t, t], [temps, temps], ["T1", "T2"]).to_dict()
+    lazy: list = [_ColumnsWhenAsked(temps)]
+    got = judge(needs, [t, t], [*lazy, _ColumnsWhenAsked(temps)], ["T1", "T2"]).to_dict()
+    assert got == want
+    one = judge(needs, [t], lazy, ["T1", "T2"]).to_dict()
+    assert one == judge(needs, [t], [temps], ["T1", "T2"]).to_dict()
+    span = next(x for x in one["tests"] if x["name"] == "temperature_span")  # T1's
+    col = temps[:, 0][np.isfinite(temps[:, 0])]
+    lo, hi = np.percentile(col, [0.1, 99.9])
+    assert span["figure"] == pytest.approx(hi - lo, rel=1e-12)

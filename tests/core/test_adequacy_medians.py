@@ -46,3 +46,28 @@ def test_ragged_window_medians_are_nanmedian() -> None:
             want = np.array([np.nanmedian(x[a:b], axis=0) if b > a else np.full(m, np.nan)
                              for a, b in zip(lo, hi, strict=True)])  # fmt: skip
         assert np.array_equal(got, want, equal_nan=True), trial
+
+
+def test_noise_of_regular_and_irregular_blocks_is_the_mad_about_each_block() -> None:
+    """σ_w of :func:`adequacy._block_stats` is 1.4826 × the median absolute deviation of
+    every ``every``-th sample from its own block's median, written here block by block
+    (regular blocks, where the block of a sample is found by arithmetic, and irregular
+    ones); the record's own values are left as they were."""
+    rng = np.random.default_rng(7)
+    for trial in range(6):
+        n = 8 * int(rng.integers(75_010, 80_000))  # 3 × SIGMA_SAMPLES: every = 3
+        t = np.arange(n) * 0.125  # exact: 8 samples a block of 1 s
+        if trial % 2:
+            t[n // 2 :] += 7.3  # a drop-out: blocks of unequal counts
+        v = rng.normal(size=(n, 2)) + 0.001 * np.arange(n)[:, None] * (trial % 3)
+        kept = v.copy()
+        _start, counts, med, sigma = adequacy._block_stats(t, v, 1.0)
+        assert np.array_equal(v, kept)
+        assert bool(np.all(counts == 8)) == (trial % 2 == 0)
+        idx = ((t - t[0]) / 1.0).astype(np.int64)
+        block_of = np.searchsorted(np.unique(idx), idx)
+        every = max(1, n // adequacy.SIGMA_SAMPLES)
+        assert every == 3
+        for j in range(2):
+            dev = np.abs(v[::every, j] - med[block_of[::every], j])
+            assert sigma[j] == 1.4826 * float(np.median(dev)), (trial, j)

@@ -201,3 +201,17 @@ def test_a_partly_lattice_thermometer_is_not_quantised() -> None:
     )
     assert lattice_step(v) is None
     assert lattice_step(0.5 * rng.integers(40, 80, 10000)) == pytest.approx(0.5, abs=1e-9)
+
+
+def test_a_continuous_reading_counts_its_distinct_values() -> None:
+    """A fine, continuous reading (no levels to merge) is described with the number of its
+    distinct values, counted here by a set; a quantised one with its merged levels."""
+    rng = np.random.default_rng(11)
+    t = np.arange(0.0, 3000.0, 0.1)
+    v = 20.0 + 10.0 * rng.random(t.size)
+    v[::7] = v[3]  # one value held at every 7th sample: counted once
+    th = describe_thermometer(t, v)
+    assert th.n_levels == len(set(v.tolist()))
+    assert th.step_c is None
+    q = 0.25 * np.round((20.0 + 10.0 * t / t[-1]) / 0.25)
+    assert describe_thermometer(t, q).n_levels == len(set(q.tolist())) == 41

@@ -63,6 +63,14 @@ def check_runs(runs: Sequence[RunData], family: str) -> list[RunData]:
     return rl
 
 
+def _central_range(temps_c: FloatArray, column: int) -> tuple[float, float]:
+    """The 2nd and 98th percentiles of one temperature column; a column that is not a view
+    (read from its file when asked for: ``temps_c`` not an array) is partitioned in place."""
+    col = temps_c[:, column]
+    lo, hi = np.percentile(col, [2, 98], overwrite_input=not isinstance(temps_c, np.ndarray))
+    return float(lo), float(hi)
+
+
 OFFSET_OVERLAP_FRACTION = 0.5
 """Two runs *overlap* when their central temperature ranges (2nd…98th percentile of the
 first temperature column) share at least this fraction of the narrower range."""
@@ -191,13 +199,7 @@ def decide_run_offsets(
     OffsetDecision
     """
     names = [r.name or f"run {i + 1}" for i, r in enumerate(runs)]
-    ranges = [
-        (
-            float(np.percentile(r.temps_c[:, column], 2)),
-            float(np.percentile(r.temps_c[:, column], 98)),
-        )
-        for r in runs
-    ]
+    ranges = [_central_range(r.temps_c, column) for r in runs]
     if len(runs) < 2:
         return OffsetDecision(False, requested, True, [names], ranges, "one run: one constant")
     groups = run_overlap_groups(ranges)

@@ -41,6 +41,7 @@ from thermocal.errors import (
     ThermocalInputError,
 )
 from thermocal.families import MAX_ORDER, MAX_TERMS
+from thermocal.pipeline.fit_columns import TemperatureBlocks, read_by_blocks, run_in_blocks
 from thermocal.pipeline.messages import warning_text
 from thermocal.pipeline.options import FitOptions
 from thermocal.pipeline.reading import check_recording
@@ -340,12 +341,20 @@ def _fit_channels(
 
 def _share_inputs(preps: list[_Prepared]) -> None:
     """Give every channel's runs the first channel's time and temperature arrays when they
-    are equal (one copy in memory, and :func:`fit_shared` sees one design)."""
+    are equal (one copy in memory, and :func:`fit_shared` sees one design); temperatures
+    read by blocks are the same when they are the same file's columns (never read whole
+    to compare them)."""
     first = preps[0].runs
     for p in preps[1:]:
         for i, r in enumerate(p.runs):
-            f = first[i]
-            if r.temps_c is not f.temps_c and np.array_equal(r.temps_c, f.temps_c):
+            f, mine = first[i], r.temps_c
+            if mine is f.temps_c:
+                continue
+            if (
+                mine.same_columns(f.temps_c)
+                if isinstance(mine, TemperatureBlocks)
+                else np.array_equal(mine, f.temps_c)
+            ):
                 p.runs[i] = dataclasses.replace(r, temps_c=f.temps_c)
 
 
@@ -388,9 +397,13 @@ def _prepare_channel(
             )  # fmt: skip
             if g_in.record is not None:  # export-params reads whether it was measured
                 first_inputs["known_input"]["gravity"] = g_in.record
-        run = _rundata.RunData.from_recording(
-            rec, signal, list(temps) if temps else None, known_input=ki, temperature_unit="auto"
-        )
+        if spec.family == "poly":  # its passes go by blocks: temperatures read as they go
+            run = run_in_blocks(rec, signal, list(temps) if temps else None, ki, validated=True)
+        else:
+            run = _rundata.RunData.from_recording(
+                rec, signal, list(temps) if temps else None, known_input=ki,
+                temperature_unit="auto",
+            )  # fmt: skip
         run = dataclasses.replace(run, name=path.name)
         if temp_names is None:
             temp_names = run.temp_names
@@ -851,13 +864,7 @@ def fit_files(paths: Sequence[Path], options: FitOptions, output: Path) -> FitRe
     family_options = _check_options(paths, o, output)
     names = list(o.signals or ())
     g_local = _local_gravity(o.gravity_axis, o.gravity, o.latitude)
-    from thermocal.readers.dispatch import read_recording
-
-    read = o.read_options
-    loaded = [
-        (path, check_recording(read_recording(path, read), read))
-        for path in station_sensor_paths(paths, o.topic)
-    ]
+    loaded = [(path, _read_run(path, o)) for path in station_sensor_paths(paths, o.topic)]
     if o.tref is not None and o.model != "poly":
         raise ParameterError(
             "tref",
@@ -902,6 +909,17 @@ def fit_files(paths: Sequence[Path], options: FitOptions, output: Path) -> FitRe
         for name, est, res, n in fitted
     )
     return FitResult(output, channels, True)
+
+
+def _read_run(path: Path, o: FitOptions) -> _recording.Recording:
+    """One run read and checked (:func:`check_recording`); a long Parquet file fitted with
+    ``poly`` read with its columns on demand, its temperatures read as the checks and the
+    fit's passes need them (:mod:`thermocal.pipeline.fit_columns`)."""
+    from thermocal.readers.dispatch import read_recording
+
+    read = o.read_options
+    blocks = o.model == "poly" and read_by_blocks(path)
+    return check_recording(read_recording(path, read, columns_on_demand=blocks), read)
 
 
 def _heater_holds(

@@ -263,6 +263,21 @@ class ColumnsOnDemand(MutableMapping[str, FloatArray]):
         if name not in self._names:
             self._names.append(name)
 
+    def read_from_file(self, name: str) -> bool:
+        """Whether ``name`` is one of the file's numeric columns, read when asked for (not
+        a column assigned to the mapping).
+
+        Parameters
+        ----------
+        name : str
+            The column.
+
+        Returns
+        -------
+        bool
+        """
+        return name in self._names and name not in self._given
+
     def __getitem__(self, name: str) -> FloatArray:
         if name in self._given:
             return self._given[name]
