@@ -163,6 +163,8 @@ def simulate_ladder(
     cut_short: int | None = None,
     cut_fraction: float = 0.2,
     temperature_c: float = TREF_C,
+    lead_s: float = 0.0,
+    rate_column: bool = True,
     **errors: float,
 ) -> tuple[Recording, dict[str, Any]]:
     """A rate ladder run on a table: gyro output, the table's rate and the temperature.
@@ -193,6 +195,12 @@ def simulate_ladder(
         The part of ``dwell_s`` that plateau holds.
     temperature_c : float
         The table's chamber temperature [°C] (the thermometer reads to 0.1 °C).
+    lead_s : float
+        The record starts this long before the program [s]: the table at rest, then
+        accelerating to the first rate (0: the record starts on the first plateau).
+    rate_column : bool
+        Write the table's rate column (False: the gyro's output and the temperature only,
+        as a gyro's own logger records a program run on the table).
     **errors : float
         The error model of :func:`expected_output` (``scale_factor``, ``quadratic_ppm``,
         ``cubic_ppm``, ``asymmetry_ppm``, ``bias_dps``, ``tc_ppm_per_c``, ``dead_zone_dps``).
@@ -217,7 +225,9 @@ def simulate_ladder(
     fs = float(np.max(np.abs(rates_dps)))
     errors = {"full_scale_dps": fs, **errors}
     dwells = [dwell_s * (cut_fraction if k == cut_short else 1.0) for k in range(len(order))]
-    time, rate, plat = _profile_dwells(order, dwells, accel_dps2, rate_hz)
+    if not (np.isfinite(lead_s) and lead_s >= 0):
+        raise ParameterError("lead_s", f"{{name}} must be ≥ 0, got {lead_s!r}")
+    time, rate, plat = _profile_dwells(order, dwells, accel_dps2, rate_hz, lead_s)
     clean = expected_output(rate, temperature_c=temperature_c, **errors)
     a = float(np.exp(-1.0 / (rate_hz * lag_s))) if lag_s > 0 else 0.0
     zi = np.array([clean[0] * a])
@@ -229,8 +239,8 @@ def simulate_ladder(
         {"gyro": gyro},
         {"temp": temp},
         signal_unit="deg/s",
-        other={"table_rate": rate},
-        other_units={"table_rate": "deg/s"},
+        other={"table_rate": rate} if rate_column else None,
+        other_units={"table_rate": "deg/s"} if rate_column else None,
         meta=Metadata(notes="simulated rate-table ladder"),
     )
     outputs = expected_output([p[2] for p in plat], temperature_c=temperature_c, **errors)
@@ -241,6 +251,7 @@ def simulate_ladder(
         "lag_s": lag_s,
         "accel_dps2": accel_dps2,
         "dwell_s": dwell_s,
+        "lead_s": lead_s,
         "order_dps": order,
         "plateaus": [{"start_s": a0, "end_s": b0, "rate_dps": r} for a0, b0, r in plat],
         "outputs": outputs.tolist(),
@@ -249,11 +260,18 @@ def simulate_ladder(
 
 
 def _profile_dwells(
-    order: Sequence[float], dwells: Sequence[float], accel_dps2: float, rate_hz: float
+    order: Sequence[float],
+    dwells: Sequence[float],
+    accel_dps2: float,
+    rate_hz: float,
+    lead_s: float = 0.0,
 ) -> tuple[FloatArray, FloatArray, list[tuple[float, float, float]]]:
-    """:func:`_profile` with a dwell per plateau."""
+    """The table's rate: a dwell per plateau, ``lead_s`` at rest before the first."""
     knots_t, knots_r, plat = [0.0], [float(order[0])], []
     t = 0.0
+    if lead_s > 0:
+        t = lead_s + abs(float(order[0])) / accel_dps2
+        knots_t, knots_r = [0.0, lead_s, t], [0.0, 0.0, float(order[0])]
     for k, (r, d) in enumerate(zip(order, dwells, strict=True)):
         if k:
             t += abs(r - knots_r[-1]) / accel_dps2
