@@ -4149,6 +4149,38 @@ MUTANTS: tuple[Mutant, ...] = (
         _t("quantiles"),
         "the Newton steps' bracket kept on the wrong side of the root",
     ),
+    Mutant(
+        "ratetable-timing-cost-sign",
+        P + "ratetable/timing.py",
+        "return math.log(max(1.0 - _r2(",
+        "return -math.log(max(1.0 - _r2(",
+        _t("ratetable_timing"),
+        "a timed ladder's start and acceleration fitted to the worst explained variance",
+    ),
+    Mutant(
+        "ratetable-timing-transition",
+        P + "ratetable/timing.py",
+        "t += abs(float(r) - float(rates_dps[k - 1])) / accel_dps2",
+        "t += abs(float(r)) / accel_dps2",
+        _t("ratetable_timing"),
+        "a timed ladder's transition from the rate, not from the step between rates",
+    ),
+    Mutant(
+        "ratetable-timing-steady-test",
+        P + "ratetable/timing.py",
+        "if d > tol and d > STEP_FRACTION * abs(k) * step:",
+        "if d > tol and d > 10 * STEP_FRACTION * abs(k) * step:",
+        _t("ratetable_timing"),
+        "a plateau holding a transition taken as steady (a mis-timed program fitted)",
+    ),
+    Mutant(
+        "ratetable-timing-length",
+        P + "ratetable/timing.py",
+        "if length > span + slack or first < t[0] - slack or last > t[-1] + slack:",
+        "if length > 2 * span + slack:",
+        _t("ratetable_timing"),
+        "a program longer than the record (or outside it from its start) not refused",
+    ),
 )
 
 

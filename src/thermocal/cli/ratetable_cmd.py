@@ -1,4 +1,5 @@
-"""``thermocal ratetable FILE... [--rate-column COL | --rates R1,R2,… [--dwell D] | --schedule FILE]``:
+"""``thermocal ratetable FILE... [--rate-column COL | --rates R1,R2,… [--dwell D] |
+--schedule FILE]``:
 a gyro's scale factor, nonlinearity, asymmetry, bias per rate, input threshold, resolution
 and repeatability from a rate-table ladder; with ``--temps`` at several temperatures, the
 scale factor's temperature coefficient.

@@ -241,7 +241,7 @@ def read_schedule(path: Path) -> tuple[tuple[float, ...], ...]:
         text = Path(path).read_text(encoding="utf-8-sig")
     except (OSError, UnicodeDecodeError) as exc:
         raise ThermocalInputError(f"{path}: cannot read the schedule ({exc})") from None
-    rows = []
+    rows: list[tuple[float, ...]] = []
     for k, line in enumerate(text.splitlines(), start=1):
         cells = [c.strip() for c in line.split(",")]
         if not line.strip() or (k == 1 and not _numbers(cells)):
@@ -257,6 +257,11 @@ def read_schedule(path: Path) -> tuple[tuple[float, ...], ...]:
     if not rows:
         raise ThermocalInputError(
             f"{path}: the schedule has no row start_s,end_s,rate_dps or rate_dps,dwell_s"
+        )
+    if len(rows[0]) == 2 and len(rows) < 2:
+        raise ThermocalInputError.naming(
+            f"{path}: a program of rate_dps,dwell_s rows in {{schedule}} needs at least 2 rates",
+            "schedule",
         )
     return tuple(rows)
 

@@ -217,7 +217,9 @@ def _refine(
     x0 = [v for v, f in zip((s0, math.log(a0)), free, strict=True) if f]
     if x0:
         steps = [s for s, f in zip((COARSE_S, 0.1), free, strict=True) if f]
-        simplex = np.array([x0] + [np.add(x0, np.eye(len(x0))[i] * steps[i]) for i in range(len(x0))])
+        simplex = np.array(
+            [x0] + [np.add(x0, np.eye(len(x0))[i] * steps[i]) for i in range(len(x0))]
+        )
         res = minimize(
             cost,
             np.asarray(x0),
@@ -245,7 +247,8 @@ def _check_program(
         raise ParameterError("rates_dps", "{name}: a ladder needs at least 2 rates")
     if len(dwells) != len(rates):
         raise ParameterError(
-            "dwell_s", f"{{name}}: {len(dwells)} dwells for {len(rates)} rates; give one, or one a rate"
+            "dwell_s",
+            f"{{name}}: {len(dwells)} dwells for {len(rates)} rates; give one, or one a rate",
         )
     for name, vals in (("dwell_s", dwells), ("accel_dps2", [] if accel is None else [accel])):
         if not all(math.isfinite(v) and v > 0 for v in vals):
