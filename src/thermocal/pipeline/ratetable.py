@@ -19,7 +19,9 @@ from thermocal import units
 from thermocal.errors import DesignError, ParameterError, ThermocalInputError, ThermocalWarning
 from thermocal.ratetable.analysis import (
     SMALL_FRACTION,
+    Figure,
     LadderResult,
+    RateRow,
     TemperatureCoefficient,
     analyse_ladder,
     temperature_coefficient,
@@ -616,3 +618,122 @@ def ratetable_files(
     return RateTableResult(
         tuple(str(p) for p in paths), tuple(dets), tuple(ladders), tc, unit, tuple(timings)
     )
+
+
+def _figure_from(d: dict[str, Any]) -> Figure:
+    """A figure from its JSON object (``value``, ``sigma``, ``reason``, its detail)."""
+    detail = {k: v for k, v in d.items() if k not in ("value", "sigma", "reason")}
+    return Figure(d["value"], d["sigma"], d["reason"], detail or None)
+
+
+def _ladder_from(d: dict[str, Any]) -> LadderResult:
+    """A ladder from its JSON object."""
+    numbers: dict[str, Any] = {k: float(d[k]) for k in _LADDER_NUMBERS}
+    figures: dict[str, Any] = {a: _figure_from(d[k]) for a, k in _LADDER_FIGURES}
+    return LadderResult(
+        **numbers,
+        **figures,
+        rows=tuple(RateRow(**r) for r in d["rates"]),
+        temperature_c=d["temperature_c"],
+        n_plateaus=int(d["n_plateaus"]),
+    )
+
+
+_LADDER_NUMBERS = (
+    "scale_factor",
+    "scale_factor_sigma",
+    "bias",
+    "bias_sigma",
+    "zero_rate_bias_dps",
+    "zero_rate_bias_sigma_dps",
+    "full_scale_dps",
+)
+_LADDER_FIGURES = (
+    ("nonlinearity", "nonlinearity_ppm_fs"),
+    ("asymmetry", "asymmetry_ppm"),
+    ("threshold", "threshold_dps"),
+    ("resolution", "resolution_dps"),
+    ("repeatability", "repeatability_ppm"),
+)
+
+
+def _detection_from(d: dict[str, Any]) -> tuple[Detection, LadderTiming | None]:
+    """A file's plateaus (sample indices not kept: 0) and its timed ladder, from JSON."""
+    keys = ("start_s", "end_s", "rate_dps", "mean", "sd", "temperature_c")
+    pl = tuple(Plateau(i0=0, i1=0, n=int(p["n"]), **{k: p[k] for k in keys}) for p in d["plateaus"])
+    det = Detection(pl, float(d["settle_s"]), str(d["source"]), tuple(map(tuple, d["dropped"])))
+    if d.get("ladder_start_s") is None:
+        return det, None
+    spans = tuple((p.start_s - det.settle_s, p.end_s) for p in pl)
+    found = tuple(d.get("found") or ())
+    return det, LadderTiming(d["ladder_start_s"], d["accel_dps2"], found, math.nan, spans)
+
+
+def result_from_dict(d: dict[str, Any]) -> RateTableResult:
+    """A rate-table result from its JSON object (:meth:`RateTableResult.to_dict`).
+
+    Parameters
+    ----------
+    d : dict
+        The object ``thermocal ratetable --json`` prints (or ``-o`` writes).
+
+    Returns
+    -------
+    RateTableResult
+        The plateaus keep their times and statistics, not their sample indices; a timed
+        ladder its start and acceleration, not its ``R²`` (NaN).
+
+    Raises
+    ------
+    ThermocalInputError
+        An object that is not a rate-table result.
+    """
+    try:
+        pairs = [_detection_from(p) for p in d["plateaus"]]
+        tc = d["temperature_coefficient"]
+        tc_args: dict[str, Any] = {
+            k: tuple(v) if isinstance(v, list) else v for k, v in (tc or {}).items()
+        }
+        return RateTableResult(
+            tuple(str(f) for f in d["files"]),
+            tuple(p[0] for p in pairs),
+            tuple(_ladder_from(ld) for ld in d["ladders"]),
+            TemperatureCoefficient(**tc_args) if tc else None,
+            str(d["output_unit"]),
+            tuple(p[1] for p in pairs),
+        )
+    except (KeyError, TypeError, ValueError, AttributeError) as exc:
+        raise ThermocalInputError(
+            f"not a rate-table result of `thermocal ratetable -o` ({type(exc).__name__}: {exc})"
+        ) from None
+
+
+def read_result(path: Path) -> RateTableResult:
+    """A rate-table result file (``thermocal ratetable -o RESULT.json``).
+
+    Parameters
+    ----------
+    path : Path
+        The JSON file.
+
+    Returns
+    -------
+    RateTableResult
+
+    Raises
+    ------
+    ThermocalInputError
+        A file that cannot be read or is not a rate-table result.
+    """
+    import json
+
+    try:
+        d = json.loads(Path(path).read_text(encoding="utf-8"))
+    except (OSError, UnicodeDecodeError, ValueError) as exc:
+        raise ThermocalInputError(f"{path}: cannot read the rate-table result ({exc})") from None
+    if not isinstance(d, dict):
+        raise ThermocalInputError(f"{path}: not a rate-table result of `thermocal ratetable -o`")
+    try:
+        return result_from_dict(d)
+    except ThermocalInputError as exc:
+        raise ThermocalInputError(f"{path}: {exc}") from None

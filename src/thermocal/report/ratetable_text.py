@@ -103,11 +103,12 @@ def ratetable_text(res: RateTableResult) -> list[Block]:
             f"{d.settle_s:g} s of each left out (settling)"
         )
         if tm is not None:
+            left = f"; {1 - tm.r2:.2g} of the output's variance off the profile's line"
             out.append(
                 f"  the ladder starts at {tm.start_s:.3f} s"
                 f" ({'found' if 'start' in tm.found else 'given'}), the table accelerating at "
-                f"{tm.accel_dps2:.4g} °/s² ({'found' if 'accel' in tm.found else 'given'}); "
-                f"{1 - tm.r2:.2g} of the output's variance left off the profile's line"
+                f"{tm.accel_dps2:.4g} °/s² ({'found' if 'accel' in tm.found else 'given'})"
+                + (left if tm.r2 == tm.r2 else "")  # NaN: read back from a result file
             )
         if d.dropped:
             spans = ", ".join(f"{a:.0f}-{b:.0f} s" for a, b in d.dropped[:8])
