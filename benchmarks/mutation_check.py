@@ -4181,6 +4181,15 @@ MUTANTS: tuple[Mutant, ...] = (
         _t("ratetable_timing"),
         "a program longer than the record (or outside it from its start) not refused",
     ),
+    Mutant(
+        "allan-segments-need-time",
+        P + "stability/allan.py",
+        "    if segments is not None:\n        return _checked_segments(segments, y.size)",
+        "    if segments is not None and time_s is not None:\n"
+        "        return _checked_segments(segments, y.size)",
+        _t("allan"),
+        "the caller's gap-free segments ignored without a time column (the ADEV across a gap)",
+    ),
 )
 
 
