@@ -4190,6 +4190,22 @@ MUTANTS: tuple[Mutant, ...] = (
         _t("allan"),
         "the caller's gap-free segments ignored without a time column (the ADEV across a gap)",
     ),
+    Mutant(
+        "thermometer-max-step-whole-degree",
+        P + "thermometer.py",
+        "MAX_STEP_C = 2.0\n",
+        "MAX_STEP_C = 0.9\n",
+        _t("thermometer"),
+        "a whole-degree thermometer taken for set temperatures (nothing reconstructed)",
+    ),
+    Mutant(
+        "thermometer-max-step-soaks",
+        P + "thermometer.py",
+        "MAX_STEP_C = 2.0\n",
+        "MAX_STEP_C = 3.0\n",
+        _t("thermometer"),
+        "soaks 2.5 °C apart taken for a thermometer and ramps invented between them",
+    ),
 )
 
 

@@ -201,3 +201,23 @@ def test_a_partly_lattice_thermometer_is_not_quantised() -> None:
     )
     assert lattice_step(v) is None
     assert lattice_step(0.5 * rng.integers(40, 80, 10000)) == pytest.approx(0.5, abs=1e-9)
+
+
+@pytest.mark.parametrize(
+    ("step", "quantised"), [(1.0, True), (2.0, True), (2.5, False), (5.0, False)]
+)
+def test_the_coarsest_thermometer_and_the_finest_set_temperatures(
+    step: float, quantised: bool
+) -> None:
+    """MAX_STEP_C (2 °C) is the line between a thermometer's resolution and a record's set
+    temperatures: a reading rounded to 1 or 2 °C along a slow ramp is a coarse thermometer
+    (reconstructed between its changes); soaks held on a 2.5 or 5 °C lattice are set
+    temperatures, their step found but nothing invented between them."""
+    t = np.arange(0.0, 6 * 3600.0, 1.0)
+    if quantised:  # a ramp −10 → 50 °C read on the lattice
+        reading = step * np.round((-10.0 + 60.0 * t / t[-1]) / step)
+    else:  # six one-hour soaks, the step apart, from 10 °C
+        reading = 10.0 + step * np.floor(t / 3600.0)
+    th = describe_thermometer(t, reading)
+    assert th.step_c == pytest.approx(step, abs=1e-9)
+    assert th.quantised is quantised
