@@ -4206,6 +4206,22 @@ MUTANTS: tuple[Mutant, ...] = (
         _t("thermometer"),
         "soaks 2.5 °C apart taken for a thermometer and ramps invented between them",
     ),
+    Mutant(
+        "heater-cold-end-unsaid",
+        P + "heater.py",
+        "cold_cut=_cold_cut(time_s, temp_c, sp, band_c, i_r, overshoot),",
+        "cold_cut=False,",
+        _t("heater"),
+        "a chamber sweep recorded with the heater on: its missing cold end not said",
+    ),
+    Mutant(
+        "heater-cold-end-warmup",
+        P + "heater.py",
+        "return bool(np.count_nonzero(below[:i_r]) * dt <= WARMUP_S)",
+        "return bool(np.count_nonzero(below[:i_r]) * dt <= 10 * WARMUP_S)",
+        _t("heater"),
+        "70 min of a weak heater tracking the chamber below its set-point taken for a warm-up",
+    ),
 )
 
 
