@@ -248,14 +248,7 @@ def make_report(
         len(cal.channels) > 1 or len(split_names(signal) or []) > 1
     )
     _check_dynamic(dynamic_s, one_channel)
-    if ratetable is not None and not one_channel:
-        raise ThermocalInputError.naming(
-            f"{models[0]} is a calibration of several channels or triads: the rate-table "
-            "section ({ratetable}) goes into the report of a one-channel model; open the "
-            "rate table's own page with `thermocal ratetable --report`",
-            "ratetable",
-        )
-    rt = _read_ratetable(ratetable)
+    rt = _read_ratetable(ratetable, one_channel, models[0])
     if cal.triads and not cal.channels:  # a turntable calibration over temperature
         return _triad_report(
             cal,
@@ -287,10 +280,18 @@ def make_report(
     )  # fmt: skip
 
 
-def _read_ratetable(path: Path | None) -> Any:
-    """The rate-table result of ``--ratetable`` (None without one)."""
+def _read_ratetable(path: Path | None, one_channel: bool, model: Path) -> Any:
+    """The rate-table result of ``--ratetable`` (None without one), refused beside a
+    calibration of several channels or triads."""
     if path is None:
         return None
+    if not one_channel:
+        raise ThermocalInputError.naming(
+            f"{model} is a calibration of several channels or triads: the rate-table section "
+            "({ratetable}) goes into the report of a one-channel model; open the rate table's "
+            "own page with `thermocal ratetable --report`",
+            "ratetable",
+        )
     from thermocal.pipeline.ratetable import read_result
 
     return read_result(path)
