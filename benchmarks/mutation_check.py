@@ -4222,6 +4222,14 @@ MUTANTS: tuple[Mutant, ...] = (
         _t("heater"),
         "70 min of a weak heater tracking the chamber below its set-point taken for a warm-up",
     ),
+    Mutant(
+        "heater-setpoint-own-scale",
+        P + "tempcal/heated.py",
+        "            setpoint -= own_minus_c",
+        "            setpoint += 0.0",
+        _t("tempcal_heater"),
+        "the set-point parameter (the IMU's own thermometer) taken on a borrowed one",
+    ),
 )
 
 

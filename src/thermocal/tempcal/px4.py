@@ -606,8 +606,9 @@ def _imu_instance(
     rec, thermo = _planned_temperature(rec, where, kind, inst, plan or ThermometerPlan())
     temp_c = rec.temperature_c("temperature")
     held = judge_instance(
-        f"{log}: {where}", rec.time_s, temp_c, flight.parameters, "px4", heater or HeaterOptions()
-    )
+        f"{log}: {where}", rec.time_s, temp_c, flight.parameters, "px4",
+        heater or HeaterOptions(), own_minus_c=thermo.get("own_minus_source_c"),
+    )  # fmt: skip
     fit = fit_sensor(rec, name, kind, inst, overrides=overrides, motions=motions)
     fit.heater = held.to_dict()
     said = record_thermometer(fit, thermo, where)
