@@ -4230,6 +4230,16 @@ MUTANTS: tuple[Mutant, ...] = (
         _t("tempcal_heater"),
         "the set-point parameter (the IMU's own thermometer) taken on a borrowed one",
     ),
+    Mutant(
+        "report-ratetable-multichannel",
+        P + "report/files.py",
+        "    if not one_channel:\n        raise ThermocalInputError.naming(\n"
+        "            f\"{model} is a calibration of several channels",
+        "    if False:\n        raise ThermocalInputError.naming(\n"
+        "            f\"{model} is a calibration of several channels",
+        _t("report_ratetable"),
+        "a rate-table result given beside a multi-channel calibration silently left out",
+    ),
 )
 
 

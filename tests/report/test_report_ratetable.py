@@ -83,3 +83,26 @@ def test_what_is_not_a_rate_table_result_refused(
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and err[0].startswith("error: ")
     assert case["rt"].read_bytes() == before
+
+
+def test_beside_a_calibration_of_several_channels_refused(
+    case: dict[str, Path], capsys: pytest.CaptureFixture[str]
+) -> None:
+    d = case["dir"]
+    t = np.arange(0.0, 4 * 3600.0, 10.0)
+    temp = -10.0 + 30.0 * (1 - np.cos(2 * np.pi * t / t[-1]))
+    noise = np.random.default_rng(0).standard_normal((2, t.size)) * 0.01
+    rec = Recording.from_arrays(
+        t, {"gx": 0.05 * temp + noise[0], "gy": -0.03 * temp + noise[1]}, {"T1": temp},
+        signal_unit="deg/h",
+    )  # fmt: skip
+    write_recording(rec, d / "two.csv")
+    assert main(["fit", str(d / "two.csv"), "--signal", "gx,gy", "--model", "poly", "-o",
+                 str(d / "two.json")]) == 0  # fmt: skip
+    capsys.readouterr()
+    out = d / "two.html"
+    assert main(["report", "--model", str(d / "two.json"), "--recording", str(d / "two.csv"),
+                 "--ratetable", str(case["rt"]), "-o", str(out)]) == 2  # fmt: skip
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith("error: ") and "--ratetable" in err[0]
+    assert "one-channel model" in err[0] and not out.exists()
