@@ -4234,9 +4234,9 @@ MUTANTS: tuple[Mutant, ...] = (
         "report-ratetable-multichannel",
         P + "report/files.py",
         "    if not one_channel:\n        raise ThermocalInputError.naming(\n"
-        "            f\"{model} is a calibration of several channels",
+        '            f"{model} is a calibration of several channels',
         "    if False:\n        raise ThermocalInputError.naming(\n"
-        "            f\"{model} is a calibration of several channels",
+        '            f"{model} is a calibration of several channels',
         _t("report_ratetable"),
         "a rate-table result given beside a multi-channel calibration silently left out",
     ),
