@@ -39,6 +39,10 @@ MIN_SWEEP_C = 2.0
 """Below this span [°C] of the temperatures outside the hold there is no sweep to fit."""
 MIN_HOLD_KEEP = 20
 """A thinned hold keeps at least this many samples."""
+WARMUP_S = 600.0
+"""Time below the set-point [s] up to which the stretch before a hold is the heater's
+warm-up from power-on, not a sweep: a record with no more below the set-point (and none
+after reaching it) is missing the cold end of its range."""
 MIN_INFERRED_SWEEP_C = 10.0
 """An inferred hold needs this sweep outside it [°C] (ArduPilot's minimum learning range):
 a self-heating warm-up of a few degrees, a turntable's or a chamber's hold at one
@@ -157,6 +161,11 @@ class HeaterHold:
     range_cut : bool
         The hold is the top of the record (no sample above the set-point beyond its band
         and overshoot): the calibrated range ends at the set-point.
+    cold_cut : bool
+        The hold is the bottom of the record: after reaching the set-point the temperature
+        never went below its band, and before it spent at most :data:`WARMUP_S` below it
+        (a warm-up from power-on), while the sweep goes on above it: the calibrated range
+        starts at the set-point (a chamber sweep recorded with the heater on).
     """
 
     setpoint_c: float
@@ -174,6 +183,7 @@ class HeaterHold:
     n_sweep: int
     sweep_c: tuple[float, float]
     range_cut: bool
+    cold_cut: bool = False
 
     @property
     def hold_s(self) -> float:
@@ -199,6 +209,7 @@ class HeaterHold:
             "n_sweep": self.n_sweep,
             "sweep_c": list(self.sweep_c),
             "range_cut": self.range_cut,
+            "cold_cut": self.cold_cut,
         }
 
 
@@ -482,7 +493,20 @@ def _describe(
         n_sweep=int(rest.size),
         sweep_c=sweep,
         range_cut=bool(float(np.max(temp_c)) <= sp + band_c + overshoot),
+        cold_cut=_cold_cut(time_s, temp_c, sp, band_c, i_r, overshoot),
     )
+
+
+def _cold_cut(
+    time_s: FloatArray, temp_c: FloatArray, sp: float, band_c: float, i_r: int, overshoot: float
+) -> bool:
+    """The hold is the bottom of the record: nothing below the band once the set-point is
+    reached (index ``i_r``), at most :data:`WARMUP_S` below it before, a sweep above it."""
+    below = temp_c < sp - band_c
+    if below[i_r:].any() or float(np.max(temp_c)) <= sp + band_c + overshoot:
+        return False
+    dt = float(np.median(np.diff(time_s))) if time_s.size > 1 else 0.0
+    return bool(np.count_nonzero(below[:i_r]) * dt <= WARMUP_S)
 
 
 def hold_mask(time_s: FloatArray, hold: HeaterHold) -> npt.NDArray[np.bool_]:
@@ -699,22 +723,33 @@ def judge_heater(
             f"from a cold start with the heater off{off}"
         )
     sentence = hold_sentence(hold)
-    notes = [sentence]
-    said: tuple[str, ...] = ()
+    tail = _cut_sentence(hold, temp_c, off, beyond)
+    if tail is None:
+        return HeaterJudgement(hold, thin_hold(time_s, temp_c, hold), (sentence,), ())
+    cut = f"{where}: {sentence}: {tail}"
+    if policy is HeaterPolicy.REFUSE:
+        raise ThermocalInputError.naming(
+            cut + ", or give {heater} cut to calibrate the range the heater left", "heater"
+        )
+    return HeaterJudgement(hold, thin_hold(time_s, temp_c, hold), (sentence, tail), (cut,))
+
+
+def _cut_sentence(hold: HeaterHold, temp_c: FloatArray, off: str, beyond: str) -> str | None:
+    """What the hold cuts off the calibrated range (its top or its cold end), or None."""
     if hold.range_cut:
-        tail = (
+        return (
             "the calibrated range ends at the set-point (the log's highest temperature "
             f"{float(np.max(temp_c)):.1f} °C; {beyond}); to calibrate above it record with "
             f"the heater off{off} or its set-point raised"
         )
-        cut = f"{where}: {sentence}: {tail}"
-        if policy is HeaterPolicy.REFUSE:
-            raise ThermocalInputError.naming(
-                cut + ", or give {heater} cut to calibrate up to the set-point", "heater"
-            )
-        said = (cut,)
-        notes.append(tail)
-    return HeaterJudgement(hold, thin_hold(time_s, temp_c, hold), tuple(notes), said)
+    if hold.cold_cut:
+        return (
+            "the cold end of the range is missing: once the heater reached its set-point the "
+            "temperature never went below it (the sweep runs from the set-point up to "
+            f"{float(np.max(temp_c)):.1f} °C; below it only the warm-up from power-on); to "
+            f"calibrate below it record the sweep with the heater off{off}"
+        )
+    return None
 
 
 def thin_recording(

@@ -35,9 +35,11 @@ from thermocal.recording import FloatArray, Recording
 MIN_STEP_C = 0.1
 """A lattice step from which a thermometer is called quantised [°C]."""
 MAX_STEP_C = 2.0
-"""The coarsest lattice step taken for a thermometer's resolution [°C] (the coarsest IMU
-thermometers read whole degrees): readings on a coarser lattice are set temperatures of the
-record (soaks) and are not reconstructed between their changes."""
+"""The coarsest lattice step taken for a thermometer's resolution [°C]: the coarsest IMU
+thermometers read whole degrees (1 °C; whole °F, 0.56 °C), while a chamber's set temperatures
+are 5 °C or more apart.  Readings on a coarser lattice are the record's set temperatures
+(soaks) and are not reconstructed between their changes; soaks 2 °C apart or closer would be
+taken for a thermometer."""
 MIN_PERIOD_S = 1.0
 """An update period from which a thermometer is called slow [s]."""
 ON_LATTICE = 0.05

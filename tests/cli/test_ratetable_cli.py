@@ -177,9 +177,12 @@ def test_schedule_and_output_over_input(
     assert main(["ratetable", str(path), "--schedule", str(sched), "-o", str(path)]) == 2
     _one_line_error(capsys)
     assert _sha(path) == before
-    sched.write_text("0,10\n")
+    sched.write_text("0,10,5,1\n")
     assert main(["ratetable", str(path), "--schedule", str(sched)]) == 2
     _one_line_error(capsys, "start_s,end_s,rate_dps")
+    sched.write_text("0,10\n")  # a program of one rate
+    assert main(["ratetable", str(path), "--schedule", str(sched)]) == 2
+    _one_line_error(capsys, "--schedule", "rate_dps,dwell_s")
 
 
 def test_reversed_ladder_warns(
@@ -285,3 +288,83 @@ def test_noisy_rate_column_needs_the_rate_tolerance(
     assert abs(ld["scale_factor"] - k) < 4 * ld["scale_factor_sigma"]
     assert main([*args, "--rate-tolerance", "-1"]) == 2
     _one_line_error(capsys, "--rate-tolerance")
+
+
+@pytest.fixture(scope="module")
+def program(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, dict]:
+    """``simulate ratetable --no-rate-column``: a program's record, its start unknown."""
+    d = tmp_path_factory.mktemp("rt3")
+    assert main(["simulate", "ratetable", "--no-rate-column", "--rate-hz", "50", "-o",
+                 str(d / "prog.csv"), "--truth", str(d / "truth.json")]) == 0  # fmt: skip
+    (truth,) = json.loads((d / "truth.json").read_text())["files"]
+    return d / "prog.csv", truth
+
+
+def test_rates_with_a_dwell_place_the_plateaus(
+    program: tuple[Path, dict], tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    path, truth = program
+    assert "table_rate" not in path.read_text().splitlines()[0]
+    assert truth["lead_s"] > 5.0 and truth["dwell_s"] == 20.0
+    before = _sha(path)
+    rates = ",".join(f"{r:g}" for r in truth["order_dps"])
+    assert main(["ratetable", str(path), f"--rates={rates}", "--dwell", "20s", "--json"]) == 0
+    res = json.loads(capsys.readouterr().out)
+    (det,) = res["plateaus"]
+    assert det["source"] == "dwell" and det["found"] == ["start", "accel"]
+    assert det["ladder_start_s"] == pytest.approx(truth["plateaus"][0]["start_s"], abs=0.03)
+    assert det["accel_dps2"] == pytest.approx(truth["accel_dps2"], rel=2e-3)
+    assert len(det["plateaus"]) == len(truth["plateaus"])  # no plateau cut short in a program
+    for p, w in zip(det["plateaus"], truth["plateaus"], strict=True):
+        assert p["rate_dps"] == w["rate_dps"]
+        assert p["start_s"] == pytest.approx(w["start_s"] + 1.0, abs=0.03)
+        assert p["end_s"] == pytest.approx(w["end_s"], abs=0.03)
+    # the scale factor against numpy.polyfit on the truth's noise-free plateau outputs
+    k_true = np.polyfit([p["rate_dps"] for p in truth["plateaus"]], truth["outputs"], 1)[0]
+    ld = res["ladders"][0]
+    assert abs(ld["scale_factor"] - k_true) < 5 * ld["scale_factor_sigma"]
+    # the same program as a schedule file of rate_dps,dwell_s rows
+    sched = tmp_path / "program.csv"
+    sched.write_text("rate_dps,dwell_s\n" + "".join(f"{r:g},20\n" for r in truth["order_dps"]))
+    assert main(["ratetable", str(path), "--schedule", str(sched), "--json"]) == 0
+    res2 = json.loads(capsys.readouterr().out)
+    assert res2["plateaus"][0]["ladder_start_s"] == det["ladder_start_s"]
+    assert res2["ladders"][0]["scale_factor"] == ld["scale_factor"]
+    assert main(["ratetable", str(path), f"--rates={rates}", "--dwell", "20s"]) == 0
+    out = capsys.readouterr().out
+    assert "plateaus from the rates and their dwell" in out and "(found)" in out
+    assert _sha(path) == before
+
+
+@pytest.mark.parametrize(
+    ("extra", "words"),
+    [
+        (["--dwell", "21s"], ("beyond the record", "--dwell")),
+        (["--dwell", "1min"], ("beyond the record", "--dwell")),
+        (["--dwell", "20", "--start", "2000"], ("beyond the record", "--start")),
+        (["--dwell", "twenty"], ("--dwell", "twenty")),
+        (["--dwell", "20,20"], ("--dwell", "one a rate")),
+        (["--dwell", "20", "--rate-column", "table_rate"], ("--dwell", "--rate-column")),
+    ],
+)
+def test_dwell_that_does_not_fit_refused(
+    program: tuple[Path, dict],
+    capsys: pytest.CaptureFixture[str],
+    extra: list[str],
+    words: tuple[str, ...],
+) -> None:
+    path, truth = program
+    rates = ",".join(f"{r:g}" for r in truth["order_dps"])
+    assert main(["ratetable", str(path), f"--rates={rates}", *extra]) == 2
+    _one_line_error(capsys, *words)
+
+
+def test_start_without_a_dwell_refused(
+    program: tuple[Path, dict], capsys: pytest.CaptureFixture[str]
+) -> None:
+    path, truth = program
+    rates = ",".join(f"{r:g}" for r in truth["order_dps"])
+    assert main(["ratetable", str(path), f"--rates={rates}", "--start", "3"]) == 2
+    _one_line_error(capsys, "--start", "--dwell")
+    assert main(["ratetable", str(path), "--dwell", "20"]) == 2
+    _one_line_error(capsys, "--dwell", "--rates")

@@ -214,3 +214,43 @@ def test_a_long_record_is_searched_on_a_bounded_subsample() -> None:
     k = -(-t.size // HOLD_MAX_SAMPLES)
     assert abs(hold.reached_s - 700.0) <= k * 1e-3 + 1e-9
     assert abs(hold.hold_end_s - t[-1]) <= k * 1e-3
+
+
+def _chamber_with_heater(boost_c: float, seed: int = 0) -> tuple[np.ndarray, np.ndarray]:
+    """A chamber sweep −20 → 70 °C over 3 h (1 Hz) recorded with a heater holding 45 °C:
+    the IMU at the ambient plus 5 °C of self-heating, plus up to ``boost_c`` from the
+    heater, never above the set-point while the ambient is below it; powered on cold, the
+    heater warming it at 0.5 °C/s at most."""
+    rng = np.random.default_rng(seed)
+    t = np.arange(0.0, 3 * 3600.0, 1.0)
+    ambient = -20.0 + 90.0 * t / t[-1]
+    own = ambient + 5.0
+    target = np.maximum(own, np.minimum(45.0, own + boost_c))
+    temp = np.minimum(target, own[0] + 0.5 * t)  # the warm-up from power-on
+    return t, temp + 0.05 * rng.standard_normal(t.size)
+
+
+def test_a_sweep_recorded_with_the_heater_on_misses_its_cold_end() -> None:
+    t, temp = _chamber_with_heater(boost_c=80.0)
+    j = judge_heater(t, temp, where="log", setpoint_c=45.0, firmware="px4")
+    assert j.hold is not None and j.hold.cold_cut and not j.hold.range_cut
+    # the ambient reaches 40 °C (45 − 5 of self-heating) at 2 h: held until then
+    assert j.hold.hold_end_s == pytest.approx(7200.0, abs=120.0)
+    (said,) = j.warnings
+    assert "cold end of the range is missing" in said and "SENS_EN_THERMAL=0" in said
+    with pytest.raises(ThermocalInputError, match="cold end"):
+        judge_heater(t, temp, where="log", setpoint_c=45.0, policy=HeaterPolicy.REFUSE)
+
+
+def test_a_weak_heater_tracking_the_chamber_below_its_setpoint_keeps_its_cold_end() -> None:
+    # 25 °C of boost: the IMU below 45 °C until the ambient reaches 15 °C (70 min)
+    t, temp = _chamber_with_heater(boost_c=25.0)
+    j = judge_heater(t, temp, where="log", setpoint_c=45.0, firmware="px4")
+    assert j.hold is not None and not j.hold.cold_cut and not j.hold.range_cut
+    assert j.warnings == ()
+
+
+def test_a_heater_hold_at_the_top_is_no_cold_cut() -> None:
+    tr = heated_truth(0)
+    hold = find_heater_hold(tr["time_s"], tr["temp"], setpoint_c=55.0)
+    assert hold is not None and hold.range_cut and not hold.cold_cut

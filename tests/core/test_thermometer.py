@@ -215,3 +215,23 @@ def test_a_continuous_reading_counts_its_distinct_values() -> None:
     assert th.step_c is None
     q = 0.25 * np.round((20.0 + 10.0 * t / t[-1]) / 0.25)
     assert describe_thermometer(t, q).n_levels == len(set(q.tolist())) == 41
+
+
+@pytest.mark.parametrize(
+    ("step", "quantised"), [(1.0, True), (2.0, True), (2.5, False), (5.0, False)]
+)
+def test_the_coarsest_thermometer_and_the_finest_set_temperatures(
+    step: float, quantised: bool
+) -> None:
+    """MAX_STEP_C (2 °C) is the line between a thermometer's resolution and a record's set
+    temperatures: a reading rounded to 1 or 2 °C along a slow ramp is a coarse thermometer
+    (reconstructed between its changes); soaks held on a 2.5 or 5 °C lattice are set
+    temperatures, their step found but nothing invented between them."""
+    t = np.arange(0.0, 6 * 3600.0, 1.0)
+    if quantised:  # a ramp −10 → 50 °C read on the lattice
+        reading = step * np.round((-10.0 + 60.0 * t / t[-1]) / step)
+    else:  # six one-hour soaks, the step apart, from 10 °C
+        reading = 10.0 + step * np.floor(t / 3600.0)
+    th = describe_thermometer(t, reading)
+    assert th.step_c == pytest.approx(step, abs=1e-9)
+    assert th.quantised is quantised

@@ -27,7 +27,7 @@ def test_ratetable_tutorial_prints_what_the_page_shows(
     page: tuple[list[tuple[str, str]], Path],
 ) -> None:
     pairs, _ = page
-    assert len(pairs) == 4
+    assert len(pairs) == 6
     for printed, shown in pairs:
         assert _numbers(printed) == _numbers(shown)
         # stripped both sides: rich versions pad a table's title differently (centred with
@@ -55,3 +55,15 @@ def test_ratetable_tutorial_figures_are_the_simulated_truth(
     assert abs(float(tc[1]) - want) < 4 * float(tc[2])
     a, b = _numbers(pairs[3][0])
     assert a == b
+
+
+def test_ratetable_tutorial_program_start_is_the_truths(
+    page: tuple[list[tuple[str, str]], Path],
+) -> None:
+    pairs, tmp = page
+    truth = json.loads((tmp / "program.json").read_text())["files"][0]
+    assert "table_rate" not in (tmp / "program.csv").read_text().splitlines()[0]
+    found = re.search(r"found: first plateau at ([\d.]+) s, table at ([\d.]+)", pairs[5][0])
+    assert found is not None
+    assert abs(float(found[1]) - truth["plateaus"][0]["start_s"]) < 0.02
+    assert abs(float(found[2]) - truth["accel_dps2"]) < 0.01 * truth["accel_dps2"]

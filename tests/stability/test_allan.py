@@ -345,3 +345,30 @@ def test_nnls_small_with_fewer_points_than_terms() -> None:
     assert np.linalg.norm(a @ x - b) == pytest.approx(
         np.linalg.norm(a @ nnls(a, b)[0] - b), abs=1e-12
     )
+
+
+def test_segments_given_without_time_are_used() -> None:
+    """Two records joined end to end with a step between them: with the segments given
+    (and no time column) the ADEV is the pooled one of the two halves, NIST SP 1065's
+    σ² = Σ_s S_s / (2 m² τ0² Σ_s L_s) written out here, not the one across the step."""
+    from thermocal.stability.allan import overlapping_adev
+
+    rng = np.random.default_rng(4)
+    a, b = rng.normal(0.0, 1.0, 4000), rng.normal(50.0, 1.0, 3000)
+    y = np.concatenate([a, b])
+    segs = [slice(0, 4000), slice(4000, 7000)]
+    got = overlapping_adev(y, 1.0, [1.0, 8.0, 64.0], segments=segs, unit="deg/h")
+    for m, dev in zip((1, 8, 64), got.adev, strict=True):
+        s, n = 0.0, 0
+        for part in (a, b):
+            x = np.concatenate([[0.0], np.cumsum(part)])
+            d = x[2 * m :] - 2 * x[m:-m] + x[: -2 * m]
+            s, n = s + float(np.sum(d**2)), n + d.size
+        assert dev == pytest.approx(np.sqrt(s / (2 * m**2 * n)), rel=1e-9)
+    with_time = overlapping_adev(
+        y, 1.0, [1.0, 8.0, 64.0], time_s=np.arange(7000.0), segments=segs, unit="deg/h"
+    )
+    np.testing.assert_allclose(with_time.adev, got.adev, rtol=1e-12)
+    for bad in ([slice(0, 4000), slice(3000, 7000)], [slice(0, 8000)], [slice(0, 10, 2)], []):
+        with pytest.raises(ThermocalInputError, match="segments"):
+            overlapping_adev(y, 1.0, [1.0], segments=bad, unit="deg/h")

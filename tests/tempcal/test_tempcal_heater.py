@@ -78,7 +78,8 @@ def test_px4_hold_reported_and_range_cut(
     assert abs(gyro["overshoot_c"] - tr["overshoot_c"]) < 0.32  # + ripple 0.2 + 4σ noise
     assert gyro["range_cut"] and gyro["heater_off_s"] is None
     cut = [ln for ln in err.splitlines() if "heater hold at 55.00 °C" in ln]
-    assert len(cut) == 2 and all(ln.startswith("warning: ") for ln in cut)  # gyro, accel
+    # once for the IMU (named by its gyro), not for its gyro and again for its accelerometer
+    assert len(cut) == 1 and cut[0].startswith("warning: ") and "sensor_gyro.0" in cut[0]
     assert "SENS_EN_THERMAL=0" in cut[0] and "stops rising" not in err
     # the parameters cover the sweep up to the set-point (and its overshoot), no further
     p = _params(d / "out" / "px4.params")
@@ -285,3 +286,28 @@ def test_whole_degree_thermometer_with_a_wider_band(
         code, _o, err = run(["px4-tempcal", str(log), "-o", str(tmp_path / "x"), option, value],
                             capsys)  # fmt: skip
         assert code == 2 and err.startswith(f"error: {option} must be positive"), err
+
+
+def test_setpoint_converted_to_the_borrowed_thermometer() -> None:
+    """Fitted on another thermometer (``--temps-from``) that reads 1.5 °C below the IMU's
+    own: the firmware holds its own at SENS_IMU_TEMP = 55 °C, so the hold is at 53.5 °C on
+    the borrowed one, reached when the truth says."""
+    from thermocal.tempcal.heated import judge_instance
+
+    tr = heated_truth(7)
+    borrowed = tr["temp"] - 1.5
+    held = judge_instance(
+        "log: sensor_gyro.0", tr["time_s"], borrowed, PX4_HEATER, "px4", HeaterOptions(),
+        own_minus_c=1.5,
+    )  # fmt: skip
+    assert held.hold is not None
+    assert held.hold.setpoint_c == pytest.approx(53.5)
+    assert abs(held.hold.reached_s - tr["reached_s"]) < 1.0
+    assert "SENS_IMU_TEMP 55 °C on the IMU's own thermometer" in held.hold.setpoint_source
+    assert "+1.50 °C from the one fitted on" in held.hold.setpoint_source
+    # unconverted, the parameter's 55 °C is never held on the borrowed thermometer: the
+    # hold is only inferred (and px4-tempcal would add a stall's warning)
+    plain = judge_instance(
+        "log: sensor_gyro.0", tr["time_s"], borrowed, PX4_HEATER, "px4", HeaterOptions()
+    )
+    assert plain.hold is not None and plain.hold.setpoint_source == "inferred"

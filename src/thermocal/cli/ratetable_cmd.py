@@ -1,4 +1,5 @@
-"""``thermocal ratetable FILE... [--rate-column COL | --rates R1,R2,… | --schedule FILE]``:
+"""``thermocal ratetable FILE... [--rate-column COL | --rates R1,R2,… [--dwell D] |
+--schedule FILE]``:
 a gyro's scale factor, nonlinearity, asymmetry, bias per rate, input threshold, resolution
 and repeatability from a rate-table ladder; with ``--temps`` at several temperatures, the
 scale factor's temperature coefficient.
@@ -6,6 +7,8 @@ scale factor's temperature coefficient.
 The library does the work (:func:`thermocal.pipeline.ratetable.ratetable_files`); this
 module parses the options and prints the result."""
 
+import math
+import re
 from pathlib import Path
 from typing import TYPE_CHECKING, Annotated
 
@@ -75,7 +78,35 @@ RatesOpt = Annotated[
 ]
 ScheduleOpt = Annotated[
     Path | None,
-    typer.Option("--schedule", help="CSV of the plateaus: start_s,end_s,rate_dps rows."),
+    typer.Option(
+        "--schedule",
+        help="CSV of the plateaus: start_s,end_s,rate_dps rows; or the table's program, "
+        "rate_dps,dwell_s rows (placed like --dwell).",
+    ),
+]
+DwellOpt = Annotated[
+    str | None,
+    typer.Option(
+        "--dwell",
+        help="How long the table held each of --rates, e.g. 60s or 1min (one for all, or one "
+        "a rate): the plateaus placed by the program's timing, no rate column needed.",
+    ),
+]
+StartOpt = Annotated[
+    float | None,
+    typer.Option(
+        "--start",
+        help="With --dwell: start of the first plateau [s of the record's time] (default: "
+        "found from the output).",
+    ),
+]
+AccelOpt = Annotated[
+    float | None,
+    typer.Option(
+        "--accel",
+        help="With --dwell: the table's acceleration between rates [°/s²] (default: found "
+        "from the output).",
+    ),
 ]
 TempsOpt = Annotated[
     str | None,
@@ -126,6 +157,29 @@ ResultOpt = Annotated[
 ]
 
 
+_DURATION = re.compile(r"^\s*([-+0-9.eE]+)\s*(s|min|h)?\s*$")
+_SECONDS = {None: 1.0, "s": 1.0, "min": 60.0, "h": 3600.0}
+
+
+def _dwells(text: str | None) -> tuple[float, ...] | None:
+    """``--dwell``: durations with an optional unit (``60``, ``60s``, ``1min``), comma-separated."""
+    if text is None:
+        return None
+    out = []
+    for item in text.split(","):
+        m = _DURATION.match(item)
+        try:
+            v = float(m.group(1)) * _SECONDS[m.group(2)] if m else math.nan
+        except ValueError:
+            v = math.nan
+        if not (math.isfinite(v) and v > 0):
+            raise ThermocalInputError(
+                f"--dwell: {item.strip()!r} is not a positive duration (60, 60s, 1min, 0.5h)"
+            )
+        out.append(v)
+    return tuple(out)
+
+
 @app.command("ratetable")
 @handle_errors
 @chamber_log_options
@@ -144,6 +198,9 @@ def ratetable_cmd(
     temp_gap_c: TempGapOpt = 3.0,
     one_direction: OneDirectionOpt = False,
     tolerance_dps: RateToleranceOpt = 1e-3,
+    dwell_s: DwellOpt = None,
+    start_s: StartOpt = None,
+    accel_dps2: AccelOpt = None,
     output: ResultOpt = None,
     report: ReportOpt = None,
     time: TimeOpt = None,
@@ -183,6 +240,9 @@ def ratetable_cmd(
         ),
         one_direction,
         tolerance_dps,
+        _dwells(dwell_s),
+        start_s,
+        accel_dps2,
     )
     res = _files.ratetable_files(files, opts, schedule=schedule)
     if output is not None:

@@ -112,6 +112,14 @@ def report_cmd(
             "section and a warning when the output is not stationary (as allan --dynamic).",
         ),
     ] = None,
+    ratetable: Annotated[
+        Path | None,
+        typer.Option(
+            "--ratetable",
+            help="A rate-table result (thermocal ratetable -o RESULT.json): its spec sheet "
+            "as a section of the report.",
+        ),
+    ] = None,
 ) -> None:
     """Write a self-contained HTML report (figures embedded, no network needed).
 
@@ -127,7 +135,7 @@ def report_cmd(
         model, recording, output, validations=list(validation or []), modeling=modeling,
         signal=signal, labels=list(label or []), title=title, sensor=sensor,
         averaging_s=averaging, latitude_deg=latitude, read=read, progress=progress,
-        dynamic_s=dynamic,
+        dynamic_s=dynamic, ratetable=ratetable,
     )  # fmt: skip
     if res.kind == "triads":
         stderr.print(f"report: {res.path}")

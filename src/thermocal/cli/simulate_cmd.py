@@ -69,6 +69,14 @@ TurnsOpt = Annotated[
         "the dividing head's stations.",
     ),
 ]
+NoRateColumnOpt = Annotated[
+    bool,
+    typer.Option(
+        "--no-rate-column",
+        help="ratetable: no table rate column, the record started before the program "
+        "(analyse with ratetable --rates … --dwell 20s).",
+    ),
+]
 FormatOpt = Annotated[str, typer.Option("--format", help="File format inside an output directory.")]
 
 
@@ -88,13 +96,22 @@ def simulate_cmd(
     record_s: RecordOpt = None,
     run: RunOpt = None,
     turns: TurnsOpt = False,
+    no_rate_column: NoRateColumnOpt = False,
     fmt: FormatOpt = "csv",
     as_json: JsonOpt = False,
 ) -> None:
     """A simulated recording (or several) with known truth."""
     _files.check_scenario(scenario)
     opts = _simulate.SimulateOptions(
-        rate_hz, latitude, axis, runs, orientation, record_s, run, turns or None
+        rate_hz,
+        latitude,
+        axis,
+        runs,
+        orientation,
+        record_s,
+        run,
+        turns or None,
+        rate_column=False if no_rate_column else None,
     )
     res = _files.simulate_files(
         scenario, output, seed=seed, profile=profile, truth=truth, options=opts, file_format=fmt

@@ -19,7 +19,9 @@ from thermocal import units
 from thermocal.errors import DesignError, ParameterError, ThermocalInputError, ThermocalWarning
 from thermocal.ratetable.analysis import (
     SMALL_FRACTION,
+    Figure,
     LadderResult,
+    RateRow,
     TemperatureCoefficient,
     analyse_ladder,
     temperature_coefficient,
@@ -35,6 +37,7 @@ from thermocal.ratetable.plateaus import (
     plateaus_from_rate,
     plateaus_from_schedule,
 )
+from thermocal.ratetable.timing import LadderTiming, plateaus_from_dwell
 from thermocal.readers import read_recording
 from thermocal.readers.options import ReadOptions
 
@@ -84,6 +87,13 @@ class RateTableOptions:
     tolerance_dps : float
         Largest change of the table's rate column between two samples of one plateau [°/s]
         (:func:`thermocal.ratetable.plateaus.plateaus_from_rate`).
+    dwell_s : tuple of float or None
+        How long the table held each of ``rates_dps`` [s] (one for all, or one a rate): the
+        plateaus placed by the program's timing (:mod:`thermocal.ratetable.timing`).
+    start_s : float or None
+        With ``dwell_s``: start of the first plateau [s, the record's time] (None: found).
+    accel_dps2 : float or None
+        With ``dwell_s``: the table's acceleration between rates [°/s²] (None: found).
     """
 
     gyro: str = "gyro"
@@ -103,6 +113,12 @@ class RateTableOptions:
     """Accept a ladder run in one direction only (no asymmetry)."""
     tolerance_dps: float = 1e-3
     """Largest change of the table's rate column between two samples of a plateau [°/s]."""
+    dwell_s: tuple[float, ...] | None = None
+    """How long each rate is held [s]: plateaus from the program's timing."""
+    start_s: float | None = None
+    """Start of the first plateau of a timed ladder [s] (None: found from the output)."""
+    accel_dps2: float | None = None
+    """The table's acceleration between the rates of a timed ladder [°/s²] (None: found)."""
 
     def __post_init__(self) -> None:
         for name in ("settle_s", "min_plateau_s", "window_s", "temp_gap_c", "tolerance_dps"):
@@ -112,6 +128,14 @@ class RateTableOptions:
                 raise ParameterError(name, f"{{name}} must be a positive number, got {v!r}")
         if self.rates_dps is not None and not all(math.isfinite(r) for r in self.rates_dps):
             raise ParameterError("rates_dps", "{name}: every rate must be a finite number")
+        if self.dwell_s is not None and not all(math.isfinite(d) and d > 0 for d in self.dwell_s):
+            raise ParameterError("dwell_s", "{name}: every dwell must be a positive number [s]")
+        if self.accel_dps2 is not None and not (
+            math.isfinite(self.accel_dps2) and self.accel_dps2 > 0
+        ):
+            raise ParameterError("accel_dps2", "{name} must be a positive number [°/s²]")
+        if self.start_s is not None and not math.isfinite(self.start_s):
+            raise ParameterError("start_s", "{name} must be a finite time [s]")
 
 
 @dataclass(frozen=True)
@@ -130,6 +154,8 @@ class RateTableResult:
         With ladders at two or more temperatures.
     output_unit : str
         The gyro output's unit (``deg/s`` for any rate unit, converted).
+    timings : tuple of (LadderTiming or None)
+        Per file, where a timed ladder (rates and dwells) was placed; None otherwise.
     """
 
     files: tuple[str, ...]
@@ -137,6 +163,7 @@ class RateTableResult:
     ladders: tuple[LadderResult, ...]
     temperature_coefficient: TemperatureCoefficient | None
     output_unit: str
+    timings: tuple[LadderTiming | None, ...] = ()
 
     @property
     def scale_factor_unit(self) -> str:
@@ -156,6 +183,7 @@ class RateTableResult:
         dict
         """
         tc = self.temperature_coefficient
+        timings = self.timings or (None,) * len(self.files)
         return {
             "files": list(self.files),
             "output_unit": self.output_unit,
@@ -167,8 +195,11 @@ class RateTableResult:
                     "settle_s": d.settle_s,
                     "dropped": [list(x) for x in d.dropped],
                     "plateaus": [_plateau_dict(p) for p in d.plateaus],
+                    "ladder_start_s": tm.start_s if tm is not None else None,
+                    "accel_dps2": tm.accel_dps2 if tm is not None else None,
+                    "found": list(tm.found) if tm is not None else None,
                 }
-                for f, d in zip(self.files, self.detections, strict=True)
+                for f, d, tm in zip(self.files, self.detections, timings, strict=True)
             ],
             "ladders": [ld.to_dict() for ld in self.ladders],
             "temperature_coefficient": tc.to_dict() if tc is not None else None,
@@ -188,8 +219,10 @@ def _plateau_dict(p: Plateau) -> dict[str, Any]:
     }
 
 
-def read_schedule(path: Path) -> tuple[tuple[float, float, float], ...]:
-    """A schedule file: CSV rows ``start_s,end_s,rate_dps`` (a header line allowed).
+def read_schedule(path: Path) -> tuple[tuple[float, ...], ...]:
+    """A schedule file: CSV rows ``start_s,end_s,rate_dps`` (the plateaus in the record's
+    time), or ``rate_dps,dwell_s`` (the table's program: each rate and how long it is held,
+    placed by :func:`thermocal.ratetable.timing.plateaus_from_dwell`); a header line allowed.
 
     Parameters
     ----------
@@ -198,30 +231,40 @@ def read_schedule(path: Path) -> tuple[tuple[float, float, float], ...]:
 
     Returns
     -------
-    tuple of (float, float, float)
+    tuple of tuple of float
+        The rows, all of three or all of two numbers.
 
     Raises
     ------
     ThermocalInputError
-        A file that cannot be read or a row that is not three numbers.
+        A file that cannot be read, a row that is not two or three numbers, or rows of both.
     """
     try:
         text = Path(path).read_text(encoding="utf-8-sig")
     except (OSError, UnicodeDecodeError) as exc:
         raise ThermocalInputError(f"{path}: cannot read the schedule ({exc})") from None
-    rows = []
+    rows: list[tuple[float, ...]] = []
     for k, line in enumerate(text.splitlines(), start=1):
         cells = [c.strip() for c in line.split(",")]
         if not line.strip() or (k == 1 and not _numbers(cells)):
             continue
         vals = _numbers(cells)
-        if vals is None or len(vals) != 3:
+        width = len(rows[0]) if rows else None
+        if vals is None or len(vals) not in (2, 3) or (width and len(vals) != width):
             raise ThermocalInputError(
-                f"{path}: line {k}: a schedule row is start_s,end_s,rate_dps, got {line!r}"
+                f"{path}: line {k}: a schedule row is start_s,end_s,rate_dps (or, every row, "
+                f"rate_dps,dwell_s), got {line!r}"
             )
-        rows.append((vals[0], vals[1], vals[2]))
+        rows.append(tuple(vals))
     if not rows:
-        raise ThermocalInputError(f"{path}: the schedule has no row start_s,end_s,rate_dps")
+        raise ThermocalInputError(
+            f"{path}: the schedule has no row start_s,end_s,rate_dps or rate_dps,dwell_s"
+        )
+    if len(rows[0]) == 2 and len(rows) < 2:
+        raise ThermocalInputError.naming(
+            f"{path}: a program of rate_dps,dwell_s rows in {{schedule}} needs at least 2 rates",
+            "schedule",
+        )
     return tuple(rows)
 
 
@@ -286,13 +329,33 @@ def _detect(
     y: np.ndarray,
     temp: np.ndarray | None,
     opts: RateTableOptions,
-    schedule: Sequence[tuple[float, float, float]] | None,
-) -> Detection:
-    """The plateaus of one file: from the schedule, the rate column, or the output."""
+    schedule: Sequence[tuple[float, ...]] | None,
+) -> tuple[Detection, LadderTiming | None]:
+    """The plateaus of one file: from a program's timing, the schedule, the rate column, or
+    the output."""
     t = rec.time_s
     settle = opts.settle_s
+    if schedule is not None and len(schedule[0]) == 2:
+        rates, dwells = [r[0] for r in schedule], [r[1] for r in schedule]
+    else:
+        rates, dwells = list(opts.rates_dps or ()), list(opts.dwell_s or ())
+    if dwells:
+        try:
+            return plateaus_from_dwell(
+                t,
+                y,
+                rates,
+                dwells * len(rates) if len(dwells) == 1 else dwells,
+                accel_dps2=opts.accel_dps2,
+                start_s=opts.start_s,
+                temperature_c=temp,
+                settle_s=settle,
+            )
+        except DesignError as exc:
+            raise DesignError.around(exc, f"{path}: ") from None
     if schedule is not None:
-        return plateaus_from_schedule(t, y, schedule, temperature_c=temp, settle_s=settle)
+        rows = [(a, b, r) for a, b, r in schedule]
+        return plateaus_from_schedule(t, y, rows, temperature_c=temp, settle_s=settle), None
     if opts.rate_column is not None:
         d = plateaus_from_rate(
             t,
@@ -305,7 +368,7 @@ def _detect(
         )
         if opts.rates_dps is not None:
             _check_given(d, opts.rates_dps, path)
-        return d
+        return d, None
     d = plateaus_from_output(
         t,
         y,
@@ -324,9 +387,38 @@ def _detect(
             "schedule",
         )
     try:
-        return match_rates(d, opts.rates_dps)
+        return match_rates(d, opts.rates_dps), None
     except DesignError as exc:
         raise DesignError.around(exc, f"{path}: ") from None
+
+
+def _check_timed(opts: RateTableOptions, sched: Sequence[tuple[float, ...]] | None) -> None:
+    """A dwell goes with the rates and without the rate column; a start or an acceleration
+    only with a dwell (or a schedule of ``rate_dps,dwell_s`` rows)."""
+    timed = opts.dwell_s is not None or (sched is not None and len(sched[0]) == 2)
+    if opts.dwell_s is not None and (opts.rates_dps is None or opts.rate_column is not None):
+        raise ThermocalInputError.naming(
+            "{dwell_s} places the plateaus of the rates given with {rates_dps}, without "
+            "{rate_column} (whose plateaus need no dwell)",
+            "dwell_s",
+            "rates_dps",
+            "rate_column",
+        )
+    if opts.dwell_s is not None and len(opts.dwell_s) not in (1, len(opts.rates_dps or ())):
+        raise ParameterError(
+            "dwell_s",
+            f"{{name}}: {len(opts.dwell_s)} dwells for {len(opts.rates_dps or ())} rates; give "
+            "one for all, or one a rate",
+        )
+    for name in ("start_s", "accel_dps2"):
+        if getattr(opts, name) is not None and not timed:
+            raise ThermocalInputError.naming(
+                f"{{{name}}} places a timed ladder: give it with {{dwell_s}} (or a {{schedule}} "
+                "of rate_dps,dwell_s rows)",
+                name,
+                "dwell_s",
+                "schedule",
+            )
 
 
 def _check_given(d: Detection, rates: Sequence[float], path: Path) -> None:
@@ -470,15 +562,21 @@ def ratetable_files(
             "several files: name their temperature column with {temps} (one file per temperature)",
             "temps",
         )
-    if schedule is not None and (len(paths) > 1 or opts.rate_column or opts.rates_dps):
+    if schedule is not None and (
+        len(paths) > 1 or opts.rate_column or opts.rates_dps or opts.dwell_s
+    ):
         raise ParameterError(
-            "schedule", "{name} gives the plateaus of one file, alone (no rates, no rate column)"
+            "schedule",
+            "{name} gives the plateaus of one file, alone (no rates, dwell or rate column)",
         )
     sched = read_schedule(schedule) if schedule is not None else None
-    dets, out_units = [], set()
+    _check_timed(opts, sched)
+    dets, timings, out_units = [], [], set()
     for p in paths:
         rec, y, unit, temp = _read(Path(p), opts)
-        dets.append(_detect(Path(p), rec, y, temp, opts, sched))
+        det, timing = _detect(Path(p), rec, y, temp, opts, sched)
+        dets.append(det)
+        timings.append(timing)
         out_units.add(unit)
     if len(out_units) != 1:
         raise ThermocalInputError.naming(
@@ -517,4 +615,125 @@ def ratetable_files(
             [ld.scale_factor for ld in ladders],
             [ld.scale_factor_sigma for ld in ladders],
         )
-    return RateTableResult(tuple(str(p) for p in paths), tuple(dets), tuple(ladders), tc, unit)
+    return RateTableResult(
+        tuple(str(p) for p in paths), tuple(dets), tuple(ladders), tc, unit, tuple(timings)
+    )
+
+
+def _figure_from(d: dict[str, Any]) -> Figure:
+    """A figure from its JSON object (``value``, ``sigma``, ``reason``, its detail)."""
+    detail = {k: v for k, v in d.items() if k not in ("value", "sigma", "reason")}
+    return Figure(d["value"], d["sigma"], d["reason"], detail or None)
+
+
+def _ladder_from(d: dict[str, Any]) -> LadderResult:
+    """A ladder from its JSON object."""
+    numbers: dict[str, Any] = {k: float(d[k]) for k in _LADDER_NUMBERS}
+    figures: dict[str, Any] = {a: _figure_from(d[k]) for a, k in _LADDER_FIGURES}
+    return LadderResult(
+        **numbers,
+        **figures,
+        rows=tuple(RateRow(**r) for r in d["rates"]),
+        temperature_c=d["temperature_c"],
+        n_plateaus=int(d["n_plateaus"]),
+    )
+
+
+_LADDER_NUMBERS = (
+    "scale_factor",
+    "scale_factor_sigma",
+    "bias",
+    "bias_sigma",
+    "zero_rate_bias_dps",
+    "zero_rate_bias_sigma_dps",
+    "full_scale_dps",
+)
+_LADDER_FIGURES = (
+    ("nonlinearity", "nonlinearity_ppm_fs"),
+    ("asymmetry", "asymmetry_ppm"),
+    ("threshold", "threshold_dps"),
+    ("resolution", "resolution_dps"),
+    ("repeatability", "repeatability_ppm"),
+)
+
+
+def _detection_from(d: dict[str, Any]) -> tuple[Detection, LadderTiming | None]:
+    """A file's plateaus (sample indices not kept: 0) and its timed ladder, from JSON."""
+    keys = ("start_s", "end_s", "rate_dps", "mean", "sd", "temperature_c")
+    pl = tuple(Plateau(i0=0, i1=0, n=int(p["n"]), **{k: p[k] for k in keys}) for p in d["plateaus"])
+    det = Detection(pl, float(d["settle_s"]), str(d["source"]), tuple(map(tuple, d["dropped"])))
+    if d.get("ladder_start_s") is None:
+        return det, None
+    spans = tuple((p.start_s - det.settle_s, p.end_s) for p in pl)
+    found = tuple(d.get("found") or ())
+    return det, LadderTiming(d["ladder_start_s"], d["accel_dps2"], found, math.nan, spans)
+
+
+def result_from_dict(d: dict[str, Any]) -> RateTableResult:
+    """A rate-table result from its JSON object (:meth:`RateTableResult.to_dict`).
+
+    Parameters
+    ----------
+    d : dict
+        The object ``thermocal ratetable --json`` prints (or ``-o`` writes).
+
+    Returns
+    -------
+    RateTableResult
+        The plateaus keep their times and statistics, not their sample indices; a timed
+        ladder its start and acceleration, not its ``R²`` (NaN).
+
+    Raises
+    ------
+    ThermocalInputError
+        An object that is not a rate-table result.
+    """
+    try:
+        pairs = [_detection_from(p) for p in d["plateaus"]]
+        tc = d["temperature_coefficient"]
+        tc_args: dict[str, Any] = {
+            k: tuple(v) if isinstance(v, list) else v for k, v in (tc or {}).items()
+        }
+        return RateTableResult(
+            tuple(str(f) for f in d["files"]),
+            tuple(p[0] for p in pairs),
+            tuple(_ladder_from(ld) for ld in d["ladders"]),
+            TemperatureCoefficient(**tc_args) if tc else None,
+            str(d["output_unit"]),
+            tuple(p[1] for p in pairs),
+        )
+    except (KeyError, TypeError, ValueError, AttributeError) as exc:
+        raise ThermocalInputError(
+            f"not a rate-table result of `thermocal ratetable -o` ({type(exc).__name__}: {exc})"
+        ) from None
+
+
+def read_result(path: Path) -> RateTableResult:
+    """A rate-table result file (``thermocal ratetable -o RESULT.json``).
+
+    Parameters
+    ----------
+    path : Path
+        The JSON file.
+
+    Returns
+    -------
+    RateTableResult
+
+    Raises
+    ------
+    ThermocalInputError
+        A file that cannot be read or is not a rate-table result.
+    """
+    import json
+
+    try:
+        d = json.loads(Path(path).read_text(encoding="utf-8"))
+    except (OSError, UnicodeDecodeError, ValueError) as exc:
+        raise ThermocalInputError(f"{path}: cannot read the rate-table result ({exc})") from None
+    if not isinstance(d, dict):
+        raise ThermocalInputError(f"{path}: not a rate-table result of `thermocal ratetable -o`")
+    try:
+        return result_from_dict(d)
+    except ThermocalInputError as exc:
+        raise ThermocalInputError(f"{path}: {exc}") from None

@@ -140,8 +140,19 @@ def ladder_order(rates: Sequence[float], *, repeats: int = 1, up_down: bool = Fa
     return one * repeats
 
 
-def _check_args(dwell_s: float, accel_dps2: float, rate_hz: float, noise_dps: float) -> None:
+def _lagged(clean: FloatArray, rate_hz: float, lag_s: float) -> FloatArray:
+    """The sensor's first-order lag of time constant ``lag_s`` (none at 0)."""
+    a = float(np.exp(-1.0 / (rate_hz * lag_s))) if lag_s > 0 else 0.0
+    zi = np.array([clean[0] * a])
+    return np.asarray(lfilter([1 - a], [1, -a], clean, zi=zi)[0] if a else clean, float)
+
+
+def _check_args(
+    dwell_s: float, accel_dps2: float, rate_hz: float, noise_dps: float, lead_s: float = 0.0
+) -> None:
     """Refuse values no table can run."""
+    if not (np.isfinite(lead_s) and lead_s >= 0):
+        raise ParameterError("lead_s", f"{{name}} must be ≥ 0, got {lead_s!r}")
     for name, v in (("dwell_s", dwell_s), ("accel_dps2", accel_dps2), ("rate_hz", rate_hz)):
         if not (np.isfinite(v) and v > 0):
             raise ParameterError(name, f"{{name}} must be a positive number, got {v!r}")
@@ -163,6 +174,8 @@ def simulate_ladder(
     cut_short: int | None = None,
     cut_fraction: float = 0.2,
     temperature_c: float = TREF_C,
+    lead_s: float = 0.0,
+    rate_column: bool = True,
     **errors: float,
 ) -> tuple[Recording, dict[str, Any]]:
     """A rate ladder run on a table: gyro output, the table's rate and the temperature.
@@ -193,6 +206,11 @@ def simulate_ladder(
         The part of ``dwell_s`` that plateau holds.
     temperature_c : float
         The table's chamber temperature [°C] (the thermometer reads to 0.1 °C).
+    lead_s : float
+        The record starts this long before the program, the table at rest [s] (0: on the
+        first plateau).
+    rate_column : bool
+        Write the table's rate column (False: the gyro and the temperature, as a logger).
     **errors : float
         The error model of :func:`expected_output` (``scale_factor``, ``quadratic_ppm``,
         ``cubic_ppm``, ``asymmetry_ppm``, ``bias_dps``, ``tc_ppm_per_c``, ``dead_zone_dps``).
@@ -212,28 +230,23 @@ def simulate_ladder(
     >>> rec.n_samples, [round(y, 4) for y in truth["outputs"]]
     (1520, [-10.001, 0.0, 10.001])
     """
-    _check_args(dwell_s, accel_dps2, rate_hz, noise_dps)
+    _check_args(dwell_s, accel_dps2, rate_hz, noise_dps, lead_s)
     order = ladder_order(rates_dps, repeats=repeats, up_down=up_down)
-    fs = float(np.max(np.abs(rates_dps)))
-    errors = {"full_scale_dps": fs, **errors}
+    errors = {"full_scale_dps": float(np.max(np.abs(rates_dps))), **errors}
     dwells = [dwell_s * (cut_fraction if k == cut_short else 1.0) for k in range(len(order))]
-    time, rate, plat = _profile_dwells(order, dwells, accel_dps2, rate_hz)
+    time, rate, plat = _profile_dwells(order, dwells, accel_dps2, rate_hz, lead_s)
     clean = expected_output(rate, temperature_c=temperature_c, **errors)
-    a = float(np.exp(-1.0 / (rate_hz * lag_s))) if lag_s > 0 else 0.0
-    zi = np.array([clean[0] * a])
-    out = lfilter([1 - a], [1, -a], clean, zi=zi)[0] if a else clean
-    gyro = out + noise_dps * rng.standard_normal(time.size)
+    gyro = _lagged(clean, rate_hz, lag_s) + noise_dps * rng.standard_normal(time.size)
     temp = np.round(temperature_c + 0.02 * rng.standard_normal(time.size), 1)
     rec = Recording.from_arrays(
         time,
         {"gyro": gyro},
         {"temp": temp},
         signal_unit="deg/s",
-        other={"table_rate": rate},
-        other_units={"table_rate": "deg/s"},
+        other={"table_rate": rate} if rate_column else None,
+        other_units={"table_rate": "deg/s"} if rate_column else None,
         meta=Metadata(notes="simulated rate-table ladder"),
     )
-    outputs = expected_output([p[2] for p in plat], temperature_c=temperature_c, **errors)
     truth = {
         **errors,
         "temperature_c": temperature_c,
@@ -241,19 +254,36 @@ def simulate_ladder(
         "lag_s": lag_s,
         "accel_dps2": accel_dps2,
         "dwell_s": dwell_s,
+        "lead_s": lead_s,
         "order_dps": order,
+    }
+    return rec, {**truth, **_plateau_truth(plat, temperature_c, errors)}
+
+
+def _plateau_truth(
+    plat: Sequence[tuple[float, float, float]], temperature_c: float, errors: dict[str, float]
+) -> dict[str, Any]:
+    """The truth's plateaus (start, end, rate) and each one's noise-free output."""
+    outputs = expected_output([p[2] for p in plat], temperature_c=temperature_c, **errors)
+    return {
         "plateaus": [{"start_s": a0, "end_s": b0, "rate_dps": r} for a0, b0, r in plat],
         "outputs": outputs.tolist(),
     }
-    return rec, truth
 
 
 def _profile_dwells(
-    order: Sequence[float], dwells: Sequence[float], accel_dps2: float, rate_hz: float
+    order: Sequence[float],
+    dwells: Sequence[float],
+    accel_dps2: float,
+    rate_hz: float,
+    lead_s: float = 0.0,
 ) -> tuple[FloatArray, FloatArray, list[tuple[float, float, float]]]:
-    """:func:`_profile` with a dwell per plateau."""
+    """The table's rate: a dwell per plateau, ``lead_s`` at rest before the first."""
     knots_t, knots_r, plat = [0.0], [float(order[0])], []
     t = 0.0
+    if lead_s > 0:
+        t = lead_s + abs(float(order[0])) / accel_dps2
+        knots_t, knots_r = [0.0, lead_s, t], [0.0, 0.0, float(order[0])]
     for k, (r, d) in enumerate(zip(order, dwells, strict=True)):
         if k:
             t += abs(r - knots_r[-1]) / accel_dps2

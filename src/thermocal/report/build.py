@@ -148,6 +148,8 @@ class ReportInputs:
         That b0 [the data's unit] instead of a window.
     dynamic_s : float, optional
         Window [s] of the dynamic Allan deviation of the compensated output.
+    ratetable : RateTableResult, optional
+        A rate-table test of the sensor (``thermocal ratetable``): its spec sheet as a section.
     """
 
     models: tuple[ModelEntry, ...]
@@ -176,6 +178,8 @@ class ReportInputs:
     dynamic_s: float | None = None
     """Window [s] of the dynamic Allan deviation of the compensated output
     (:func:`thermocal.stability.allan.dynamic_adev`, half-window steps); None: none."""
+    ratetable: Any = None
+    """A :class:`thermocal.pipeline.ratetable.RateTableResult`: its spec sheet as a section."""
 
 
 # --- number formatting -------------------------------------------------------------------
@@ -1661,6 +1665,7 @@ def build_report(inputs: ReportInputs) -> str:
     run_warnings = [
         warning_text(w.message) for w in caught if issubclass(w.category, ThermocalWarning)
     ]
+    ratetable = _ratetable_section(inputs.ratetable)
     ctx = {
         "title": inputs.title,
         "sensor": inputs.sensor or rec.meta.sensor_id or "",
@@ -1699,11 +1704,21 @@ def build_report(inputs: ReportInputs) -> str:
         "known_input": an.main.known_input,
         "averaging_s": an.averaging_s,
         "limit_r": WEAK_CORRELATION_LIMIT,
-        "n_figures": len(figs),
+        "n_figures": len(figs) + (ratetable.count("<img ") if ratetable else 0),
         "temp_names": ", ".join(an.temp_names),
+        "ratetable": Markup(ratetable) if ratetable else None,
     }
     html: str = _env().get_template("report.html.j2").render(**ctx)
     return html
+
+
+def _ratetable_section(res: Any) -> str | None:
+    """The rate-table spec sheet's HTML (:func:`thermocal.report.ratetable.ratetable_section`)."""
+    if res is None:
+        return None
+    from thermocal.report.ratetable import ratetable_section
+
+    return ratetable_section(res)
 
 
 def write_report(path: str | Path, inputs: ReportInputs) -> Path:

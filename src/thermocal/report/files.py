@@ -195,6 +195,7 @@ def make_report(
     read: ReadOptions | None = None,
     progress: Progress | None = None,
     dynamic_s: float | None = None,
+    ratetable: Path | None = None,
 ) -> ReportResult:
     """``thermocal report``: a self-contained HTML report written atomically to ``output``.
 
@@ -219,6 +220,9 @@ def make_report(
         (default the file's metadata); window of the dynamic Allan deviation [s].
     read, progress : ReadOptions, callable, optional
         How the recordings are read; what draws the steps.
+    ratetable : pathlib.Path, optional
+        A rate-table result (``thermocal ratetable -o``): its spec sheet as a section of a
+        model's report.
 
     Returns
     -------
@@ -237,14 +241,14 @@ def make_report(
     bar = progress or _no_progress
     _check_counts(models, validations, labels)
     inputs_files: list[str | Path] = [*models, *validations, recording]
-    if modeling is not None:
-        inputs_files.append(modeling)
+    inputs_files += [p for p in (modeling, ratetable) if p is not None]
     check_not_input(output, inputs_files)
     cal = load_calibration(models[0])
     one_channel = not (cal.triads and not cal.channels) and not (
         len(cal.channels) > 1 or len(split_names(signal) or []) > 1
     )
     _check_dynamic(dynamic_s, one_channel)
+    rt = _read_ratetable(ratetable, one_channel, models[0])
     if cal.triads and not cal.channels:  # a turntable calibration over temperature
         return _triad_report(
             cal,
@@ -272,8 +276,25 @@ def make_report(
     return _models_report(
         models, recording, output, opts, bar, validations=validations, modeling=modeling,
         signal=signal, labels=labels, title=title, sensor=sensor, averaging_s=averaging_s,
-        dynamic_s=dynamic_s,
+        dynamic_s=dynamic_s, ratetable=rt,
     )  # fmt: skip
+
+
+def _read_ratetable(path: Path | None, one_channel: bool, model: Path) -> Any:
+    """The rate-table result of ``--ratetable`` (None without one), refused beside a
+    calibration of several channels or triads."""
+    if path is None:
+        return None
+    if not one_channel:
+        raise ThermocalInputError.naming(
+            f"{model} is a calibration of several channels or triads: the rate-table section "
+            "({ratetable}) goes into the report of a one-channel model; open the rate table's "
+            "own page with `thermocal ratetable --report`",
+            "ratetable",
+        )
+    from thermocal.pipeline.ratetable import read_result
+
+    return read_result(path)
 
 
 def _triad_report(
@@ -314,6 +335,7 @@ def _models_report(
     sensor: str | None,
     averaging_s: float | None,
     dynamic_s: float | None = None,
+    ratetable: Any = None,
 ) -> ReportResult:
     """Model files reported and compared: both runs read with the same options (what they
     warn shown in the report too)."""
@@ -367,6 +389,7 @@ def _models_report(
             averaging_s=averaging_s,
             warnings_caught=read_warnings,
             dynamic_s=dynamic_s,
+            ratetable=ratetable,
         )
         advance(1)
         path = write_report(output, inputs)

@@ -148,9 +148,29 @@ def ratetable_html(res: RateTableResult, title: str = "Rate-table test") -> str:
     str
         A self-contained HTML page (figures embedded).
     """
-    parts = [
+    head = (
         f"<!DOCTYPE html><html><head><meta charset='utf-8'><title>{escape(title)}</title>"
-        f"<style>{STYLE}</style></head><body><h1>{escape(title)}</h1>",
+        f"<style>{STYLE}</style></head><body><h1>{escape(title)}</h1>"
+    )
+    return "\n".join([head, ratetable_section(res), "</body></html>\n"])
+
+
+def ratetable_section(res: RateTableResult) -> str:
+    """The spec sheet as an HTML fragment: the standards, the text rendering's tables and
+    lines, then the figures (``ratetable --report``'s page, ``report --ratetable``'s
+    section).
+
+    Parameters
+    ----------
+    res : RateTableResult
+        The test.
+
+    Returns
+    -------
+    str
+        HTML, figures embedded; text escaped.
+    """
+    parts = [
         "<p>Terms of IEEE Std 528-2001; test procedures of IEEE Std 952-1997 and IEEE Std "
         "1431-2004. Uncertainties are 1σ, from the plateaus' noise.</p>",
     ]
@@ -168,5 +188,4 @@ def ratetable_html(res: RateTableResult, title: str = "Rate-table test") -> str:
             f'src="{scale_factor_figure(tc)}" alt="scale factor against temperature">'
             "</figure>"
         )
-    parts.append("</body></html>\n")
     return "\n".join(parts)

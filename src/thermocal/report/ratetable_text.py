@@ -95,11 +95,21 @@ def ratetable_text(res: RateTableResult) -> list[Block]:
     list of str or TextTable
     """
     out: list[Block] = []
-    for f, d in zip(res.files, res.detections, strict=True):
+    timings = res.timings or (None,) * len(res.files)
+    for f, d, tm in zip(res.files, res.detections, timings, strict=True):
+        source = "rates and their dwell" if d.source == "dwell" else d.source
         out.append(
-            f"{f}: {len(d.plateaus)} plateaus from the {d.source}, the first "
+            f"{f}: {len(d.plateaus)} plateaus from the {source}, the first "
             f"{d.settle_s:g} s of each left out (settling)"
         )
+        if tm is not None:
+            left = f"; {1 - tm.r2:.2g} of the output's variance off the profile's line"
+            out.append(
+                f"  the ladder starts at {tm.start_s:.3f} s"
+                f" ({'found' if 'start' in tm.found else 'given'}), the table accelerating at "
+                f"{tm.accel_dps2:.4g} °/s² ({'found' if 'accel' in tm.found else 'given'})"
+                + (left if tm.r2 == tm.r2 else "")  # NaN: read back from a result file
+            )
         if d.dropped:
             spans = ", ".join(f"{a:.0f}-{b:.0f} s" for a, b in d.dropped[:8])
             out.append(f"  {len(d.dropped)} steady stretch(es) too short, left out: {spans}")

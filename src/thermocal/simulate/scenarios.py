@@ -751,7 +751,10 @@ def scenario_ratetable(seed: int, profile: ProfileInput = None, **opts: Any) -> 
     """A gyro on a rate table (:func:`thermocal.ratetable.simulate.simulate_ladder`): the
     default ±300 °/s ladder with small rates, run up and back down, one plateau cut short,
     with the table's finite acceleration and overshoot; ``runs`` ladders at temperatures
-    over −20…+60 °C (one at 25 °C by default), one file each.
+    over −20…+60 °C (one at 25 °C by default), one file each.  ``rate_column=False``: what
+    a gyro's own logger records of a program run on the table (20 s at each rate): no rate
+    column, no plateau cut short, the record started 5–30 s (random, in the truth's
+    ``lead_s``) before the program, the table at rest until then.
 
     Parameters
     ----------
@@ -760,7 +763,7 @@ def scenario_ratetable(seed: int, profile: ProfileInput = None, **opts: Any) -> 
     profile : None
         Must be None (no chamber program).
     **opts
-        ``runs`` (temperatures) and ``rate_hz``.
+        ``runs`` (temperatures), ``rate_hz`` and ``rate_column``.
 
     Returns
     -------
@@ -774,6 +777,7 @@ def scenario_ratetable(seed: int, profile: ProfileInput = None, **opts: Any) -> 
     """
     if profile is not None:
         raise ThermocalInputError("the ratetable scenario takes no chamber profile")
+    column = bool(opts.pop("rate_column", True))
     from thermocal.ratetable.simulate import simulate_ladder
 
     runs = int(opts.pop("runs", 1))
@@ -785,7 +789,10 @@ def scenario_ratetable(seed: int, profile: ProfileInput = None, **opts: Any) -> 
     for t in temps:
         try:
             kw: dict[str, Any] = {**opts, **RATETABLE_ERRORS}
-            rec, truth = simulate_ladder(rng, up_down=True, cut_short=30, temperature_c=t, **kw)
+            if not column:
+                kw.update(rate_column=False, lead_s=float(rng.uniform(5.0, 30.0)))
+            cut = 30 if column else None
+            rec, truth = simulate_ladder(rng, up_down=True, cut_short=cut, temperature_c=t, **kw)
         except TypeError as exc:
             raise ThermocalInputError(f"ratetable: {exc}") from None
         label = f"T{t:+.0f}" if runs > 1 else ""
@@ -1035,6 +1042,8 @@ class SimulateOptions:
     turns : bool, optional
         Multi-position sessions with the six named faces and 360° turns; a continuous
         tumble instead of the dividing head's stations (tumble).
+    rate_column : bool, optional
+        ratetable: write the table's rate column (False: a program's record, the gyro alone).
 
     Raises
     ------
@@ -1052,6 +1061,8 @@ class SimulateOptions:
     run: str | None = None
     turns: bool | None = None
     """multipos: Ferraris sessions (six named faces and 360° turns)."""
+    rate_column: bool | None = None
+    """ratetable: the table's rate column written (False: the gyro's output alone)."""
 
     def __post_init__(self) -> None:
         rate, lat = self.rate_hz, self.latitude_deg

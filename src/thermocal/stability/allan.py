@@ -756,13 +756,36 @@ def _checked_rate(rate: npt.ArrayLike, tau0_s: float, overwrite: bool) -> tuple[
 def _gap_free_slices(
     y: FloatArray, time_s: npt.ArrayLike | None, segments: list[slice] | None
 ) -> list[slice]:
-    """The gap-free index ranges of the record (the whole record without a time column)."""
-    if time_s is None:
-        return [slice(0, y.size)]
-    t = np.asarray(time_s, dtype=np.float64).ravel()
-    if t.shape != y.shape:
-        raise ThermocalInputError(f"time has {t.size} samples but rate has {y.size}")
-    return segments if segments is not None else contiguous_slices(t)
+    """The gap-free index ranges of the record: ``segments`` when given (checked: increasing,
+    disjoint, inside the record), else from the time column, else the whole record."""
+    if time_s is not None:
+        t = np.asarray(time_s, dtype=np.float64).ravel()
+        if t.shape != y.shape:
+            raise ThermocalInputError(f"time has {t.size} samples but rate has {y.size}")
+    if segments is not None:
+        return _checked_segments(segments, y.size)
+    return [slice(0, y.size)] if time_s is None else contiguous_slices(t)
+
+
+def _checked_segments(segments: list[slice], n: int) -> list[slice]:
+    """The caller's gap-free ranges as ``slice(start, stop)``, refused unless they are
+    increasing, disjoint, non-empty, of step 1 and inside the ``n`` samples."""
+    out: list[slice] = []
+    last = 0
+    for sl in segments:
+        ok = isinstance(sl, slice) and sl.step in (None, 1)
+        a, b, _ = sl.indices(n) if ok else (0, 0, 1)
+        given: tuple[Any, ...] = (sl.start, sl.stop) if ok else ()
+        if not ok or a < last or b <= a or any(v is not None and not 0 <= v <= n for v in given):
+            raise ThermocalInputError(
+                f"segments: {sl!r} is not a gap-free range of the {n} samples after the one "
+                "before it (slices of step 1, increasing, disjoint, non-empty)"
+            )
+        out.append(slice(a, b))
+        last = b
+    if not out:
+        raise ThermocalInputError("segments: no range given")
+    return out
 
 
 def _pooled_sums(
@@ -820,7 +843,8 @@ def overlapping_adev(
         the per-τ sums of squares pooled, :math:`\sigma^2 = \sum_s S_s / (2 m^2 \sum_s
         L_s)`; the EDFs add.
     segments : list of slice, optional
-        The gap-free index ranges, when the caller has them.
+        The gap-free index ranges, when the caller has them (used with or without
+        ``time_s``; increasing, disjoint, inside the record, else refused).
     unit : str
         Unit of ``rate`` (reported, and used by :func:`noise_terms`).
     confidence : float

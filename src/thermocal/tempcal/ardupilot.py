@@ -1090,7 +1090,7 @@ def _imu(run: _Run, data: _ImuData) -> None:
             source=run.plan.source_for(kind, inst),
         )  # fmt: skip
         if held is None:  # one thermometer per IMU: the same for its two sensors
-            held = _heater(run, inst, sub_rec)
+            held = _heater(run, inst, sub_rec, thermo.get("own_minus_source_c"))
         fit = fit_sensor(
             sub_rec, f"IMU.{prefix}", kind, inst, overrides=run.overrides,
             firmware="ardupilot", motions=run.motions,
@@ -1125,14 +1125,17 @@ def _imu(run: _Run, data: _ImuData) -> None:
     _reports(run, inst, per_kind, ps, held, emulated, active, fw_range)
 
 
-def _heater(run: _Run, inst: int, rec: Recording) -> HeaterJudgement:
+def _heater(
+    run: _Run, inst: int, rec: Recording, own_minus_c: float | None = None
+) -> HeaterJudgement:
     """IMU ``inst``'s heater hold (:func:`.heated.judge_instance`) judged on the temperature
-    its fits take (``rec``'s: reconstructed, or borrowed), its warnings and a stall's
-    (no hold, or an inferred one) added to the run's gates."""
+    its fits take (``rec``'s: reconstructed, or borrowed, ``own_minus_c`` below its own),
+    its warnings and a stall's (no hold, or an inferred one) added to the run's gates."""
     time_s, temp_c = rec.time_s, rec.temperature_c("temperature")
     held = judge_instance(
-        f"{run.log}: IMU.{inst}", time_s, temp_c, run.flight.parameters, "ardupilot", run.heater
-    )
+        f"{run.log}: IMU.{inst}", time_s, temp_c, run.flight.parameters, "ardupilot",
+        run.heater, own_minus_c=own_minus_c,
+    )  # fmt: skip
     run.gates.extend(held.warnings)
     if held.hold is None or held.hold.setpoint_source == "inferred":  # a stall, or a heater?
         run.gates.append(stall_warning(f"IMU.{inst}", time_s, temp_c))

@@ -29,9 +29,15 @@ def judge_instance(
     params: Mapping[str, float],
     firmware: str,
     options: HeaterOptions,
+    *,
+    own_minus_c: float | None = None,
 ) -> HeaterJudgement:
     """One IMU instance's heater hold: the set-point given, else the log's parameter, else
     inferred; none looked for when the log's parameters say the heater is off.
+
+    The firmware holds its own thermometer at the parameter's set-point: fitted on another
+    thermometer (``--temps-from``) that reads ``own_minus_c`` below the IMU's own, the hold
+    is looked for at ``T_sp − own_minus_c`` on it, and its source says so.
 
     Parameters
     ----------
@@ -45,6 +51,10 @@ def judge_instance(
         Whose parameters (:data:`thermocal.heater.HEATER_PARAMS`).
     options : HeaterOptions
         The policy, a set-point given, the band and the shortest hold.
+    own_minus_c : float, optional
+        The IMU's own thermometer less the one ``temp_c`` comes from (median) [°C]: the
+        parameter's set-point converted by it (a set-point given is taken as given, in the
+        temperature fitted on).
 
     Returns
     -------
@@ -62,6 +72,12 @@ def judge_instance(
         if setpoint is None and found is not None:  # the heater off in the parameters
             return HeaterJudgement(None, None, (), ())
         source = found or "given"
+        if setpoint is not None and own_minus_c:  # the firmware's own thermometer's scale
+            source = (
+                f"{found} {setpoint:g} °C on the IMU's own thermometer, which reads "
+                f"{own_minus_c:+.2f} °C from the one fitted on"
+            )
+            setpoint -= own_minus_c
     judged = judge_heater(
         time_s, temp_c, where=where, policy=options.policy, setpoint_c=setpoint,
         setpoint_source=source, firmware=firmware, band_c=options.band_c,

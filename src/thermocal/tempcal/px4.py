@@ -426,6 +426,7 @@ def _px4_tempcal(
     fits: list[SensorFit] = []
     offset_fits: list[OffsetFit] = []
     gates: list[str | None] = []
+    heater_said: dict[int, dict[str, tuple[str, ...]]] = {}
     series: dict[str, tuple[FloatArray, FloatArray]] = {}
     motions: dict[str, adequacy.Motion] = {}
     params = ParamSet("px4")
@@ -439,12 +440,14 @@ def _px4_tempcal(
                 if ofit is not None:
                     offset_fits.append(ofit)
                 continue
-            fit, more = _imu_instance(
+            fit, more, heat = _imu_instance(
                 flight, name, inst, tref_c, overrides, params, out_set, (series, motions), old,
                 allan, heater or HeaterOptions(), emulated, plan or ThermometerPlan(),
             )  # fmt: skip
             fits.append(fit)
+            heater_said.setdefault(inst, {})[name] = heat
             gates.extend(more)
+        gates.extend(_heater_warnings(heater_said))
         gates.extend(step_warnings(fits, series, motions))
         warn_gates(gates)
         if not fits:
@@ -558,6 +561,15 @@ def _offset_instance(
     return ofit
 
 
+def _heater_warnings(said: dict[int, dict[str, tuple[str, ...]]]) -> list[str]:
+    """The heater's warnings once per IMU: instance i's gyro and accelerometer are one chip
+    on one heater; the gyro's said, else the accelerometer's."""
+    out: list[str] = []
+    for _, by_topic in sorted(said.items()):
+        out.extend(by_topic.get("sensor_gyro") or by_topic.get("sensor_accel") or ())
+    return out
+
+
 def _imu_instance(
     flight: FlightLog,
     name: str,
@@ -572,8 +584,9 @@ def _imu_instance(
     heater: HeaterOptions | None = None,
     emulated: dict[str, Px4Emulation] | None = None,
     plan: ThermometerPlan | None = None,
-) -> tuple[SensorFit, list[str | None]]:
-    """A gyro or accelerometer instance through the pipeline: read, fit, its gates, its
+) -> tuple[SensorFit, list[str | None], tuple[str, ...]]:
+    """A gyro or accelerometer instance through the pipeline: read, fit, its gates (its
+    heater's warnings apart: said once per IMU by the caller), its
     ``TC_G``/``TC_A`` parameters merged into ``params``, its report (``allan``: with its
     Allan section); ``found`` (series, motions) gets its (time [s], x/y/z in the canonical
     unit) and its stillness result for the step check across instances; ``heater``: how its
@@ -593,14 +606,15 @@ def _imu_instance(
     rec, thermo = _planned_temperature(rec, where, kind, inst, plan or ThermometerPlan())
     temp_c = rec.temperature_c("temperature")
     held = judge_instance(
-        f"{log}: {where}", rec.time_s, temp_c, flight.parameters, "px4", heater or HeaterOptions()
-    )
+        f"{log}: {where}", rec.time_s, temp_c, flight.parameters, "px4",
+        heater or HeaterOptions(), own_minus_c=thermo.get("own_minus_source_c"),
+    )  # fmt: skip
     fit = fit_sensor(rec, name, kind, inst, overrides=overrides, motions=motions)
     fit.heater = held.to_dict()
     said = record_thermometer(fit, thermo, where)
     # the step check across instances reads the stillness result (motions), not the values
     series[where] = (rec.time_s, np.empty((0, len(AXES))))
-    gates: list[str | None] = [*held.warnings]
+    gates: list[str | None] = []
     if held.hold is None or held.hold.setpoint_source == "inferred":  # a stall, or a heater?
         gates.append(stall_warning(where, rec.time_s, temp_c))
     if kind == "gyro":
@@ -654,7 +668,7 @@ def _imu_instance(
             emulated_learning=None if em is None else em.against_thermocal,
         ),
     )  # fmt: skip
-    return fit, gates
+    return fit, gates, held.warnings
 
 
 def _planned_temperature(
