@@ -45,6 +45,8 @@ def test_fit_on_the_chamber_temperature_and_validate_with_it(
     coefs = json.loads(model.read_text())
     assert fit["temperature_range"] == {"chamber": [pytest.approx(-10.0), pytest.approx(60.0)]}
     assert coefs["inputs"]["unit_sources"]["chamber"] == "chamber log"
+    joined = coefs["inputs"]["chamber_log"]  # the model file says how the log was joined
+    assert (joined["method"], joined["offset_s"], joined["unit"]) == ("given", 1234.0, "degF")
     val = _json(capsys, "validate", str(model), str(rec), "--ambient", "chamber", *UNITS, *chamber)
     assert val["ambient"] == "chamber"
     assert float(val["rms_after"]) < 0.0125  # the 0.01 deg/h noise left  # type: ignore[arg-type]
