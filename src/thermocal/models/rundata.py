@@ -262,7 +262,8 @@ def model_inputs(
     and where each was stated, the raw-count temperature conversions, the scale factor of
     a raw-count signal, the known input removed (value in the canonical unit and what
     it is) and, for a temperature from a chamber's own log, how that log was joined
-    (``chamber_log``: the log, its channel and unit, the clocks' offset and drift).  ``rec`` is a recording read by :func:`thermocal.readers.dispatch.read_recording`.
+    (``chamber_log``: the log, its channel and unit, the clocks' offset and drift).
+    ``rec`` is a recording read by :func:`thermocal.readers.dispatch.read_recording`.
 
     Parameters
     ----------
