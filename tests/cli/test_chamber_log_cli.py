@@ -45,6 +45,8 @@ def test_fit_on_the_chamber_temperature_and_validate_with_it(
     coefs = json.loads(model.read_text())
     assert fit["temperature_range"] == {"chamber": [pytest.approx(-10.0), pytest.approx(60.0)]}
     assert coefs["inputs"]["unit_sources"]["chamber"] == "chamber log"
+    joined = coefs["inputs"]["chamber_log"]  # the model file says how the log was joined
+    assert (joined["method"], joined["offset_s"], joined["unit"]) == ("given", 1234.0, "degF")
     val = _json(capsys, "validate", str(model), str(rec), "--ambient", "chamber", *UNITS, *chamber)
     assert val["ambient"] == "chamber"
     assert float(val["rms_after"]) < 0.0125  # the 0.01 deg/h noise left  # type: ignore[arg-type]
@@ -153,3 +155,33 @@ def test_a_record_streamed_window_by_window_refuses_the_log(
         err = capsys.readouterr().err.splitlines()
         assert code == 2 and len(err) == 1, err
         assert "read without a chamber log; drop --chamber-log" in err[0]
+
+
+def test_validate_on_another_run_with_its_own_log(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    log, rec, _ = _files(tmp_path)
+    other, _ = write_recording(tmp_path / "other.csv", offset_s=3000.0, span_s=12000.0, seed=5)
+    model = tmp_path / "m.json"
+    chamber = ("--chamber-log", str(log), "--chamber-offset")
+    fit = ["fit", str(rec), "--model", "poly", "--order", "1", "--signal", "gx"]
+    assert main([*fit, "--temps", "chamber", *UNITS, *chamber, "1234", "-o", str(model)]) == 0
+    capsys.readouterr()
+    code = main(["validate", str(model), str(other), "--ambient", "chamber", *UNITS,
+                 *chamber, "3000", "--json"])  # fmt: skip
+    out, err = capsys.readouterr()
+    assert code == 0, err
+    # the modelling run's own chamber history is not known: r is not computed, and said
+    assert json.loads(out)["r"] is None
+    assert "the modelling run has no chamber log: r of the ambient histories not computed" in err
+    # the same line on the other run: 0.02 deg/h/°C removed, the 0.01 deg/h noise left
+    assert float(json.loads(out)["rms_after"]) < 0.0125
+
+
+def test_correlate_chamber_logs_names_channels_after_a_colon(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    log = write_log(tmp_path / "a.csv", span_s=3000.0)
+    code = main(["profile", "correlate", str(log), str(log), "--chamber-logs", "--column", "TC1"])
+    err = capsys.readouterr().err.splitlines()
+    assert code == 2 and len(err) == 1 and "FILE:CHANNEL, not with --column" in err[0], err

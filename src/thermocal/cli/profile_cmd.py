@@ -336,6 +336,11 @@ def correlate_cmd(
 ) -> None:
     """r = Cov(X, Y)/(σX σY) of two temperature histories on a common elapsed-time base."""
     if chamber_logs:
+        if column is not None or column_b is not None:
+            raise ThermocalInputError(
+                "--chamber-logs: name each log's channel after a colon, FILE:CHANNEL, not "
+                "with --column"
+            )
         given = {"chamber_unit": chamber_unit, "chamber_date": chamber_date,
                  "chamber_date_order": chamber_date_order}  # fmt: skip
         ta, xa, ca = _chamber_history(file_a, given)

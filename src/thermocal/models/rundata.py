@@ -260,8 +260,10 @@ def model_inputs(
     """What a model file records of how its fitted data were written (``inputs``): the
     time unit, the signal's and temperatures' units as given (e.g. ``deg/s``, ``counts``)
     and where each was stated, the raw-count temperature conversions, the scale factor of
-    a raw-count signal, and the known input removed (value in the canonical unit and what
-    it is).  ``rec`` is a recording read by :func:`thermocal.readers.dispatch.read_recording`.
+    a raw-count signal, the known input removed (value in the canonical unit and what
+    it is) and, for a temperature from a chamber's own log, how that log was joined
+    (``chamber_log``: the log, its channel and unit, the clocks' offset and drift).
+    ``rec`` is a recording read by :func:`thermocal.readers.dispatch.read_recording`.
 
     Parameters
     ----------
@@ -300,6 +302,9 @@ def model_inputs(
         }
     if rec.meta.sensor_id:
         out["sensor_id"] = str(rec.meta.sensor_id)
+    joined = rec.meta.extra.get("chamber_log")
+    if joined and any(rec.unit_sources.get(c) == "chamber log" for c in temps):
+        out["chamber_log"] = dict(joined)  # the log, channel, offset and drift it was joined by
     if rec.n_samples > 1:  # sizes the Ṫ buffer of the exported C (export-c)
         out["sample_interval_s"] = float(rec.sample_interval_s)
     canon = canonical_unit(sig_unit) if sig_unit else None
