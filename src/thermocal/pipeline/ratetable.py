@@ -675,7 +675,7 @@ def result_from_dict(d: dict[str, Any]) -> RateTableResult:
     Parameters
     ----------
     d : dict
-        The object ``thermocal ratetable --json`` prints (or ``-o`` writes).
+        The object :meth:`RateTableResult.to_dict` gives (what the command line prints or writes).
 
     Returns
     -------

@@ -49,8 +49,8 @@ def _units(value: Iterable[str]) -> tuple[str, ...]:
 
 
 CHAMBER_COLUMN = "chamber"
-"""The temperature column a chamber log adds to a recording (``--temps chamber``,
-``--ambient chamber``)."""
+"""The temperature column a chamber log adds to a recording (name it among the
+temperatures or as the ambient column)."""
 
 
 @dataclass(frozen=True)

@@ -281,7 +281,7 @@ def make_report(
 
 
 def _read_ratetable(path: Path | None, one_channel: bool, model: Path) -> Any:
-    """The rate-table result of ``--ratetable`` (None without one), refused beside a
+    """The rate-table result read from ``path`` (None without one), refused beside a
     calibration of several channels or triads."""
     if path is None:
         return None
@@ -289,7 +289,7 @@ def _read_ratetable(path: Path | None, one_channel: bool, model: Path) -> Any:
         raise ThermocalInputError.naming(
             f"{model} is a calibration of several channels or triads: the rate-table section "
             "({ratetable}) goes into the report of a one-channel model; open the rate table's "
-            "own page with `thermocal ratetable --report`",
+            "own page with `thermocal ratetable --report`",  # cli-words: the command that draws it
             "ratetable",
         )
     from thermocal.pipeline.ratetable import read_result

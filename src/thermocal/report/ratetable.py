@@ -157,8 +157,8 @@ def ratetable_html(res: RateTableResult, title: str = "Rate-table test") -> str:
 
 def ratetable_section(res: RateTableResult) -> str:
     """The spec sheet as an HTML fragment: the standards, the text rendering's tables and
-    lines, then the figures (``ratetable --report``'s page, ``report --ratetable``'s
-    section).
+    lines, then the figures (the rate-table test's own page, and its section in a model's
+    report).
 
     Parameters
     ----------

@@ -1,4 +1,4 @@
-"""The tumble test as a self-contained HTML page (``thermocal tumble --report``): the
+"""The tumble test as a self-contained HTML page (the tumble command's report): the
 coefficients table, then the output against the head's angle with the fitted harmonics and,
 below, each point's residual with what the second harmonic (K2, K_ip) adds.  matplotlib is
 imported only when a figure is drawn."""

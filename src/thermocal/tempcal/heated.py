@@ -36,7 +36,7 @@ def judge_instance(
     inferred; none looked for when the log's parameters say the heater is off.
 
     The firmware holds its own thermometer at the parameter's set-point: fitted on another
-    thermometer (``--temps-from``) that reads ``own_minus_c`` below the IMU's own, the hold
+    thermometer (``temps_from``) that reads ``own_minus_c`` below the IMU's own, the hold
     is looked for at ``T_sp − own_minus_c`` on it, and its source says so.
 
     Parameters

@@ -463,6 +463,18 @@ def _thermal_outputs(
     return gyro, acc
 
 
+def _with_g_sensitivity(
+    gyro: FloatArray, f_true: FloatArray, a_deg_h_g: npt.ArrayLike | None
+) -> FloatArray:
+    """The gyro [rad/s] plus :math:`A f`, ``A`` [°/h per g] and ``f`` the true specific force
+    [m/s²] over :math:`g_0` = 9.80665 m/s² (unchanged without ``A``)."""
+    if a_deg_h_g is None:
+        return gyro
+    a_sens = np.asarray(a_deg_h_g, dtype=np.float64).reshape(3, 3)
+    out: FloatArray = gyro + (f_true / units.STANDARD_GRAVITY_M_S2) @ a_sens.T * units.DH_TO_RS
+    return out
+
+
 def _thermal_recording(
     t: FloatArray,
     gyro: FloatArray,
@@ -515,10 +527,9 @@ def simulate_turntable_thermal(
     drop_position: tuple[str, int] | None = None,
     g_sensitivity_deg_h_g: npt.ArrayLike | None = None,
 ) -> list[tuple[Recording, dict[str, Any]]]:
-    r"""16-position runs at several soak temperatures plus a held-out run at an unseen one,
-    of a gyro and an accelerometer triad whose every parameter follows
-    :data:`GYRO_THERMAL_TRUTH` / :data:`ACCEL_THERMAL_TRUTH` at each sample's temperature;
-    the soak drifts by ``drift_c`` during each run (a chamber that has not quite settled).
+    r"""16-position runs at several soaks plus a held-out run at an unseen one, of a gyro and
+    an accelerometer triad whose every parameter follows :data:`GYRO_THERMAL_TRUTH` /
+    :data:`ACCEL_THERMAL_TRUTH` at each sample's temperature; the soak drifts by ``drift_c``.
 
     Parameters
     ----------
@@ -547,9 +558,8 @@ def simulate_turntable_thermal(
     drop_position : tuple of (str, int) or None, optional
         ``(label, index)``: that run misses that position (default none).
     g_sensitivity_deg_h_g : array_like, shape (3, 3), optional
-        The gyro's sensitivity to specific force ``A`` [°/h per g], constant in temperature
-        (default none): :math:`A f` added to the gyro, ``f`` the true specific force in g
-        (:math:`g_0` = 9.80665 m/s²).
+        The gyro's sensitivity ``A`` [°/h per g], constant in temperature: :math:`A f`
+        added to the gyro, ``f`` the true specific force in g (default none).
 
     Returns
     -------
@@ -585,12 +595,9 @@ def simulate_turntable_thermal(
             n, t, a_deg, b_deg, omega_true, f_true = _kinematic(kept, *motion)
         temp = soak + drift_c * (t / t[-1] - 0.5)
         arw = arw_deg_sqrt_h * units.DEG_TO_RAD / np.sqrt(units.SECONDS_PER_HOUR)
-        gyro, acc = _thermal_outputs(
-            omega_true, f_true, temp, rng, arw / np.sqrt(tau), accel_noise_mg
-        )
-        if g_sensitivity_deg_h_g is not None:
-            a_sens = np.asarray(g_sensitivity_deg_h_g, dtype=np.float64).reshape(3, 3)
-            gyro = gyro + (f_true / units.STANDARD_GRAVITY_M_S2) @ a_sens.T * units.DH_TO_RS
+        gyro, acc = _thermal_outputs(omega_true, f_true, temp, rng, arw / np.sqrt(tau),
+                                     accel_noise_mg)  # fmt: skip
+        gyro = _with_g_sensitivity(gyro, f_true, g_sensitivity_deg_h_g)
         enc = encoder_noise_arcsec * units.ARCSEC_TO_DEG
         alpha = np.mod(a_deg + rng.standard_normal(n) * enc, 360.0)
         beta = np.mod(b_deg + rng.standard_normal(n) * enc, 360.0)
