@@ -363,7 +363,8 @@ def _command_options(fn: Callable[..., Any]) -> dict[str, str]:
         for info in getattr(hint, "__metadata__", ()):
             first = getattr(info, "default", None)  # Annotated: the first declaration
             given = (first, *(getattr(info, "param_decls", None) or ()))
-            decls = [d for d in given if isinstance(d, str) and d.startswith("--")]
+            # a flag's "--name/--no-name" is named by its first spelling
+            decls = [d.split("/")[0] for d in given if isinstance(d, str) and d.startswith("--")]
             if isinstance(info, typer.models.OptionInfo):
                 out[name] = decls[0] if decls else "--" + name.replace("_", "-")
     return out
