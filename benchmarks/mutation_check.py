@@ -4149,6 +4149,30 @@ MUTANTS: tuple[Mutant, ...] = (
         _t("quantiles"),
         "the Newton steps' bracket kept on the wrong side of the root",
     ),
+    Mutant(
+        "plain-coercion-int-any-text",
+        P + "cli/coercion.py",
+        "return int(value) if kind is str and _INT.fullmatch(value) else _UNDECIDED",
+        "return int(value) if kind is str else _UNDECIDED",
+        _t("cli_coercion"),
+        "an int option converts any text itself (a ValueError, not typer's error line)",
+    ),
+    Mutant(
+        "plain-coercion-float-hex",
+        P + "cli/coercion.py",
+        '_FLOAT = re.compile(r"-?(?:[0-9]+',
+        '_FLOAT = re.compile(r"(?:0x)?-?(?:[0-9]+',
+        _t("cli_coercion"),
+        "a float option converts 0x10 itself (typer refuses it with its message)",
+    ),
+    Mutant(
+        "plain-coercion-path-empty",
+        P + "cli/coercion.py",
+        'if annotation is Path and kind is str and value and "\\x00" not in value:',
+        'if annotation is Path and kind is str and "\\x00" not in value:',
+        _t("cli_coercion"),
+        "an empty path converted to Path('') itself",
+    ),
 )
 
 
