@@ -29,6 +29,7 @@ import numpy.typing as npt
 
 from thermocal import units
 from thermocal._lazy import LazyModule
+from thermocal.data_units import data_unit_of
 from thermocal.errors import (
     MissingValueError,
     ParameterError,
@@ -1248,33 +1249,6 @@ def hold_stages(
         for s in segs
         if s.kind == "hold" and s.stop > s.start
     )
-
-
-def data_unit_of(rec: Recording, name: str, canonical: str) -> tuple[str, float]:
-    """The unit a signal's figures are shown in and the factor ``k`` with
-    ``value[canonical] = k · value[shown]``.
-
-    The column's own unit as given (``deg/s`` stays ``deg/s``); raw counts are shown in
-    the unit :meth:`Recording.signal` gave them (``canonical``: [°/h] or [mg] when a scale
-    factor K converted them, else ``counts``), so k = 1.
-
-    Parameters
-    ----------
-    rec : Recording
-        The recording.
-    name : str
-        Signal name.
-    canonical : str
-        Unit :meth:`Recording.signal` gave the signal.
-
-    Returns
-    -------
-    tuple of (str, float)
-        The shown unit and the factor k.
-    """
-    given = rec.units.get(name)
-    shown = units.shown_unit(canonical, units.normalize_signal_unit(given) if given else None)
-    return shown.unit, shown.to_model
 
 
 def earth_rate_to_remove(
