@@ -18,6 +18,7 @@ def test_deg_per_second_stays_deg_per_second() -> None:
     assert unit == "deg/s"
     np.testing.assert_allclose(values, rate, rtol=1e-15)
     canonical, canon = rec.signal("gx")
+    np.testing.assert_allclose(canonical, rate * 3600.0, rtol=1e-15)
     assert canon == "deg/h"
     assert data_unit_of(rec, "gx", canon) == ("deg/s", 3600.0)  # 1 °/s = 3600 °/h
 
