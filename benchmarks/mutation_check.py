@@ -2039,8 +2039,8 @@ MUTANTS: tuple[Mutant, ...] = (
     Mutant(
         "readers-jitter-half-range",
         P + "recording.py",
-        "float(p95 - p5) / (2.0 * med)",
-        "float(p95 - p5) / med",
+        "(p95 - p5) / (2.0 * med)",
+        "(p95 - p5) / med",
         H38R,
         "jitter as the whole 5–95 % range, not its half",
     ),
@@ -4172,6 +4172,30 @@ MUTANTS: tuple[Mutant, ...] = (
         'if annotation is Path and kind is str and "\\x00" not in value:',
         _t("cli_coercion"),
         "an empty path converted to Path('') itself",
+    ),
+    Mutant(
+        "jitter-median-even-one-value",
+        P + "recording.py",
+        "float((steps[half - 1] + steps[half]) / 2)",
+        "float((steps[half] + steps[half]) / 2)",
+        _t("time_jitter"),
+        "the median of an even count taken as the upper middle value",
+    ),
+    Mutant(
+        "jitter-percentile-no-neighbour",
+        P + "recording.py",
+        "above = np.minimum(below + 1, n - 1)",
+        "above = below",
+        _t("time_jitter"),
+        "the 5 and 95 % percentiles read at the lower neighbour (no interpolation)",
+    ),
+    Mutant(
+        "jitter-percentile-lerp-branch",
+        P + "recording.py",
+        "np.where(gamma >= 0.5, b - diff * (1 - gamma), a + diff * gamma)",
+        "np.where(gamma > 0.5, b - diff * (1 - gamma), a + diff * gamma)",
+        _t("time_jitter"),
+        "the interpolation from below at γ = ½ (numpy's from above: other last bits)",
     ),
 )
 

@@ -1034,13 +1034,31 @@ def time_jitter(time_s: FloatArray) -> TimeJitter | None:
     dt = np.diff(t)
     if bool((dt < 0).any()):
         return None
-    med = float(np.median(dt))
+    n_same = int(np.count_nonzero(dt == 0))
+    med, p5, p95 = _median_p5_p95(dt)
     if not med > 0:
-        return TimeJitter(med, math.inf, int(np.count_nonzero(dt == 0)), int(dt.size))
-    p5, p95 = np.percentile(dt, [5.0, 95.0])
-    return TimeJitter(
-        med, float(p95 - p5) / (2.0 * med), int(np.count_nonzero(dt == 0)), int(dt.size)
-    )
+        return TimeJitter(med, math.inf, n_same, int(dt.size))
+    return TimeJitter(med, (p95 - p5) / (2.0 * med), n_same, int(dt.size))
+
+
+def _median_p5_p95(steps: FloatArray) -> tuple[float, float, float]:
+    """``np.median`` and ``np.percentile(…, [5, 95])`` (linear) of at least two finite
+    values, equal to them to the bit, from one partition of ``steps`` (reordered in place)
+    instead of one per call: the median's middle value(s) and each percentile's two
+    neighbours are placed together, then read as numpy reads them (the mean of the two
+    middle values; ``a + (b − a)·γ``, or ``b − (b − a)·(1 − γ)`` for γ ≥ ½, at the virtual
+    index (n − 1)·q)."""
+    n = steps.size
+    virtual = (n - 1) * (np.asarray([5.0, 95.0]) / 100)
+    below = np.floor(virtual).astype(np.intp)
+    above = np.minimum(below + 1, n - 1)
+    half = n // 2
+    steps.partition(sorted({half - 1 + n % 2, half, *below.tolist(), *above.tolist()}))
+    med = float(steps[half]) if n % 2 else float((steps[half - 1] + steps[half]) / 2)
+    a, b, gamma = steps[below], steps[above], virtual - below
+    diff = b - a
+    q = np.where(gamma >= 0.5, b - diff * (1 - gamma), a + diff * gamma)
+    return med, float(q[0]), float(q[1])
 
 
 LOST_SAMPLE_JUMP = 0.5
