@@ -1487,8 +1487,8 @@ MUTANTS: tuple[Mutant, ...] = (
     Mutant(
         "inspect-saturation-unreported",
         P + "inspection.py",
-        "            problems.extend(_saturation_problems(name, arr))",
-        "            pass",
+        "        problems.extend(_saturation_problems(name, arr))",
+        "        pass",
         ("tests/multipos/test_multipos_real_sessions.py",),
         "inspect says nothing of samples on the int16 rails",
     ),
@@ -4196,6 +4196,22 @@ MUTANTS: tuple[Mutant, ...] = (
         "np.where(gamma > 0.5, b - diff * (1 - gamma), a + diff * gamma)",
         _t("time_jitter"),
         "the interpolation from below at γ = ½ (numpy's from above: other last bits)",
+    ),
+    Mutant(
+        "metrics-keeps-last-temperature",
+        P + "metrics.py",
+        "rec.columns[names[0]] = rec.columns[names[0]]",
+        "rec.columns[names[-1]] = rec.columns[names[-1]]",
+        _t("cli_columns_on_demand"),
+        "metrics keeps the last temperature, not the one that defines the stages (read twice)",
+    ),
+    Mutant(
+        "checks-signals-before-temperatures",
+        P + "recording.py",
+        "order += [n for n in dict.fromkeys((*rec.temperatures, *rec.signals)) if n in names]",
+        "order += [n for n in dict.fromkeys((*rec.signals, *rec.temperatures)) if n in names]",
+        _t("cli_columns_on_demand"),
+        "the checks end on a temperature: the signal is read again for the figures",
     ),
 )
 

@@ -1537,6 +1537,28 @@ class MetricsOptions:
         )
 
 
+def keep_stage_temperature(rec: Recording, temps: Sequence[str] | None) -> None:
+    """Keep the temperature that defines the hold stages (the first of ``temps``, else of
+    the recording's) in the recording's columns once read.
+
+    A recording read on demand (``metrics``: each column read when used, the last one
+    kept) would otherwise read it twice: once for its checks and once more for the
+    figures, which need it beside the signal read after it.  Kept, it is read once, and
+    every column of the recording once; the memory is that of the figures, which hold it
+    with the signal anyway.  A recording held in memory is unchanged.
+
+    Parameters
+    ----------
+    rec : Recording
+        The recording (its ``columns`` are reassigned the column's own values).
+    temps : sequence of str or None
+        The temperature columns asked for (the first defines the stages).
+    """
+    names = list(temps) if temps else list(rec.temperatures)
+    if names and names[0] in rec.columns:
+        rec.columns[names[0]] = rec.columns[names[0]]
+
+
 def channel_metrics(
     rec: Recording, names: list[str], options: MetricsOptions
 ) -> dict[str, MetricsResult]:
@@ -1764,6 +1786,7 @@ __all__ = [
     "earth_rate_to_remove",
     "empty_reference_window",
     "hold_stages",
+    "keep_stage_temperature",
     "peak_to_peak",
     "power_on_metrics",
     "reference_bias",
