@@ -177,7 +177,11 @@ def _give(param: Any, cls: type) -> bool:
         return False
     if desc.file_annotation is not None:
         return False
-    param._runtime_param = cls(parameter_info=desc.parameter_info, annotation=desc.annotation)
+    try:
+        plain = cls(parameter_info=desc.parameter_info, annotation=desc.annotation)
+    except TypeError:  # a typer whose RuntimeParam asks for more: its own conversion
+        return False
+    param._runtime_param = plain
     return True
 
 
