@@ -25,7 +25,7 @@ ROOT = Path(__file__).resolve().parents[1] / "src" / "thermocal"
 LAYERS: dict[str, int] = {
     # 1 core: the glossary, the types, the gates
     "_lazy": 1, "_version": 1, "errors": 1, "defaults": 1, "units": 1, "identifiers": 1, "outputs": 1,
-    "recording": 1, "families": 1,
+    "recording": 1, "families": 1, "data_units": 1,
     # 2 maths: pure functions on arrays
     "preprocess": 2, "thermometer": 2, "metrics": 2, "profiles": 2, "inspection": 2, "adequacy": 2, "gravity": 2,
     "heater": 2,

@@ -454,47 +454,15 @@ def inspect_recording(rec: Recording, skipped: Sequence[str] = ()) -> Inspection
     )
     med = median_interval(t) if t.size > 1 else float("nan")
     gaps = find_gaps(t) if time_ok else []
-    columns: dict[str, ColumnSummary] = {}
-    span: dict[str, list[float] | None] = {}
-    for name, arr in rec.columns.items():
-        role = (
-            "signal"
-            if name in rec.signals
-            else "temperature"
-            if name in rec.temperatures
-            else "other"
-        )
-        nan = np.isnan(arr)
-        n_nan = int(np.count_nonzero(nan))
-        # no copy of the column when it is all finite (the common case)
-        finite = arr if n_nan == 0 and bool(np.isfinite(arr).all()) else arr[np.isfinite(arr)]
-        n_spikes, first_spike = count_spikes(t, arr) if time_ok and role != "other" else (0, None)
-        if n_spikes:
-            problems.append(
-                Problem(
-                    "spikes",
-                    f"column {name!r} has {n_spikes} spike samples (Hampel test, "
-                    f"{SPIKE_THRESHOLD:g} robust σ), first at row {first_spike}",
-                    severity="warning",
-                    column=name,
-                    row=first_spike,
-                )
-            )
-        if role != "temperature" and rec.units.get(name) != "degC":  # a setpoint's holds
-            problems.extend(_saturation_problems(name, arr))
-        columns[name] = ColumnSummary(
-            name=name,
-            role=role,
-            unit=rec.units.get(name, ""),
-            min=float(finite.min()) if finite.size else None,
-            max=float(finite.max()) if finite.size else None,
-            mean=float(finite.mean()) if finite.size else None,
-            n_nan=n_nan,
-            first_nan_row=int(np.argmax(nan)) if n_nan else None,
-            n_spikes=n_spikes,
-        )
-        if role == "temperature":
-            span[name] = _temperature_span_c(rec, name)
+    names = list(rec.columns)
+    # the last signal first: the checks above read it last, and a recording read on demand
+    # keeps it (every other column is read once more, not twice); results in column order
+    held = [n for n in rec.signals if n in names][-1:]
+    done = {n: _column_summary(rec, n, time_ok) for n in held + [n for n in names if n not in held]}
+    problems += [p for n in names for p in done[n][1]]
+    columns = {n: done[n][0] for n in names}
+    span = {n: done[n][2] for n in names if done[n][0].role == "temperature"}
+    thermometers = {n: done[n][3] for n in span if time_ok and span[n] is not None}
     return Inspection(
         file=rec.name,
         n_samples=rec.n_samples,
@@ -508,8 +476,54 @@ def inspect_recording(rec: Recording, skipped: Sequence[str] = ()) -> Inspection
         problems=problems + _skipped_problems(skipped),
         time_ok=time_ok,
         timestamp_jitter=rec.time_jitter(),
-        thermometers={n: _thermometer(rec, n) for n in span if time_ok and span[n] is not None},
+        thermometers=thermometers,
     )
+
+
+def _column_summary(
+    rec: Recording, name: str, time_ok: bool
+) -> tuple[ColumnSummary, list[Problem], list[float] | None, dict[str, Any] | None]:
+    """One column's summary, its spike and rail problems, and for a temperature its span
+    [°C] and its thermometer (None when the span is None or the time is not usable), all
+    from one read of the column."""
+    t, arr = rec.time_s, rec.columns[name]
+    role = (
+        "signal" if name in rec.signals else "temperature" if name in rec.temperatures else "other"
+    )
+    problems: list[Problem] = []
+    nan = np.isnan(arr)
+    n_nan = int(np.count_nonzero(nan))
+    # no copy of the column when it is all finite (the common case)
+    finite = arr if n_nan == 0 and bool(np.isfinite(arr).all()) else arr[np.isfinite(arr)]
+    n_spikes, first_spike = count_spikes(t, arr) if time_ok and role != "other" else (0, None)
+    if n_spikes:
+        problems.append(
+            Problem(
+                "spikes",
+                f"column {name!r} has {n_spikes} spike samples (Hampel test, "
+                f"{SPIKE_THRESHOLD:g} robust σ), first at row {first_spike}",
+                severity="warning",
+                column=name,
+                row=first_spike,
+            )
+        )
+    if role != "temperature" and rec.units.get(name) != "degC":  # a setpoint's holds
+        problems.extend(_saturation_problems(name, arr))
+    summary = ColumnSummary(
+        name=name,
+        role=role,
+        unit=rec.units.get(name, ""),
+        min=float(finite.min()) if finite.size else None,
+        max=float(finite.max()) if finite.size else None,
+        mean=float(finite.mean()) if finite.size else None,
+        n_nan=n_nan,
+        first_nan_row=int(np.argmax(nan)) if n_nan else None,
+        n_spikes=n_spikes,
+    )
+    del nan, finite
+    span = _temperature_span_c(rec, name) if role == "temperature" else None
+    thermometer = _thermometer(rec, name) if time_ok and span is not None else None
+    return summary, problems, span, thermometer
 
 
 def _thermometer(rec: Recording, name: str) -> dict[str, Any] | None:

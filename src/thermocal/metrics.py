@@ -29,6 +29,7 @@ import numpy.typing as npt
 
 from thermocal import units
 from thermocal._lazy import LazyModule
+from thermocal.data_units import data_unit_of
 from thermocal.errors import (
     MissingValueError,
     ParameterError,
@@ -1250,33 +1251,6 @@ def hold_stages(
     )
 
 
-def data_unit_of(rec: Recording, name: str, canonical: str) -> tuple[str, float]:
-    """The unit a signal's figures are shown in and the factor ``k`` with
-    ``value[canonical] = k · value[shown]``.
-
-    The column's own unit as given (``deg/s`` stays ``deg/s``); raw counts are shown in
-    the unit :meth:`Recording.signal` gave them (``canonical``: [°/h] or [mg] when a scale
-    factor K converted them, else ``counts``), so k = 1.
-
-    Parameters
-    ----------
-    rec : Recording
-        The recording.
-    name : str
-        Signal name.
-    canonical : str
-        Unit :meth:`Recording.signal` gave the signal.
-
-    Returns
-    -------
-    tuple of (str, float)
-        The shown unit and the factor k.
-    """
-    given = rec.units.get(name)
-    shown = units.shown_unit(canonical, units.normalize_signal_unit(given) if given else None)
-    return shown.unit, shown.to_model
-
-
 def earth_rate_to_remove(
     rec: Recording,
     name: str,
@@ -1563,6 +1537,28 @@ class MetricsOptions:
         )
 
 
+def keep_stage_temperature(rec: Recording, temps: Sequence[str] | None) -> None:
+    """Keep the temperature that defines the hold stages (the first of ``temps``, else of
+    the recording's) in the recording's columns once read.
+
+    A recording read on demand (``metrics``: each column read when used, the last one
+    kept) would otherwise read it twice: once for its checks and once more for the
+    figures, which need it beside the signal read after it.  Kept, it is read once, and
+    every column of the recording once; the memory is that of the figures, which hold it
+    with the signal anyway.  A recording held in memory is unchanged.
+
+    Parameters
+    ----------
+    rec : Recording
+        The recording (its ``columns`` are reassigned the column's own values).
+    temps : sequence of str or None
+        The temperature columns asked for (the first defines the stages).
+    """
+    names = list(temps) if temps else list(rec.temperatures)
+    if names and names[0] in rec.columns:
+        rec.columns[names[0]] = rec.columns[names[0]]
+
+
 def channel_metrics(
     rec: Recording, names: list[str], options: MetricsOptions
 ) -> dict[str, MetricsResult]:
@@ -1790,6 +1786,7 @@ __all__ = [
     "earth_rate_to_remove",
     "empty_reference_window",
     "hold_stages",
+    "keep_stage_temperature",
     "peak_to_peak",
     "power_on_metrics",
     "reference_bias",

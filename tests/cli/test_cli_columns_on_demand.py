@@ -143,3 +143,40 @@ def test_a_file_too_large_whole_is_read_on_demand(
     err = capsys.readouterr().err.strip().splitlines()
     assert err[-1].startswith(f"error: {path}: reading 6,000 rows of 3 column(s)")
     assert "THERMOCAL_MEMORY_LIMIT" in err[-1]
+
+
+def _reads(monkeypatch: pytest.MonkeyPatch) -> dict[str, int]:
+    """How many times each column is read from the file (``numeric_column``)."""
+    import thermocal.readers.table as table
+
+    counts: dict[str, int] = {}
+    original = table.numeric_column
+
+    def counted(source: Any, name: str, path: Path) -> Any:
+        counts[name] = counts.get(name, 0) + 1
+        return original(source, name, path)
+
+    monkeypatch.setattr(table, "numeric_column", counted)
+    return counts
+
+
+def test_metrics_reads_each_column_once(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    src = _file(tmp_path)
+    args = ["metrics", str(src), "--signal", "gyro", "--temps", "T1,T2,T3,T4", "--json"]
+    reads = _reads(monkeypatch)
+    assert main(args) == 0
+    assert reads == {"gyro": 1, "T1": 1, "T2": 1, "T3": 1, "T4": 1}
+    assert json.loads(capsys.readouterr().out)["n_samples"] == N
+
+
+def test_inspect_reads_each_column_at_most_twice(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    src = _file(tmp_path)
+    reads = _reads(monkeypatch)
+    assert main(["inspect", str(src), "--json"]) == 0
+    # the checks read every column once, the summaries every column but the signal once more
+    assert reads == {"gyro": 1, "T1": 2, "T2": 2, "T3": 2, "T4": 2}
+    assert set(json.loads(capsys.readouterr().out)["thermometers"]) == {"T1", "T2", "T3", "T4"}

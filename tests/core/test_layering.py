@@ -41,6 +41,7 @@ MATHS_MODULES = (
     "thermocal.adequacy",
     "thermocal.gravity",
     "thermocal.compensate.kernels",
+    "thermocal.data_units",
 )
 MATHS_PACKAGES = (
     "thermocal.stability",

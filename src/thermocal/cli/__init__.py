@@ -21,6 +21,7 @@ from typing import Any
 import typer
 
 from thermocal.cli.application import app as _app
+from thermocal.cli.coercion import install as install_plain_coercion
 from thermocal.cli.interrupt import report_interrupted
 
 COMMANDS: dict[str, str] = {
@@ -109,10 +110,14 @@ def _click_command() -> Any:
     """The application as typer builds it for click, once per set of registered command
     modules: typer rebuilds every command's parameters from their annotations on each call
     of the application (≈ 6 ms a command), which a process running many commands in a row
-    (``thermocal fleet``'s units) would pay every time."""
+    (``thermocal fleet``'s units) would pay every time.  Its parameters convert their
+    values without pydantic where typer's result is not in doubt
+    (:func:`thermocal.cli.coercion.install`)."""
     key = frozenset(_REGISTERED)
     if key not in _CLICK:
-        _CLICK[key] = typer.main.get_command(_app)
+        command = typer.main.get_command(_app)
+        install_plain_coercion(command)
+        _CLICK[key] = command
     return _CLICK[key]
 
 

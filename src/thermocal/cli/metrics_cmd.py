@@ -143,6 +143,7 @@ def metrics_cmd(
         # metrics use the signal and the temperatures only
         # (each column read when used: the signal and one temperature held, not all)
         rec = _readers.read_recording(file, r, keep_other=False, columns_on_demand=True)
+        _metrics.keep_stage_temperature(rec, split_names(temps))  # every column read once
         return check_recording(rec, r)
 
     def options() -> "_metrics.MetricsOptions":

@@ -11,7 +11,7 @@ Pure maths on a :class:`~thermocal.recording.Recording` already read (no file la
 * :func:`imu_noise`: the estimator noise model of a gyro (and accelerometer) triad
   (:mod:`thermocal.stability.noise_model`).
 
-Every figure is in the data's own unit (:func:`thermocal.metrics.data_unit_of`); doubtful
+Every figure is in the data's own unit (:func:`thermocal.data_units.data_unit_of`); doubtful
 results are :class:`~thermocal.errors.ConditioningWarning` naming ``where`` (the file).
 """
 
@@ -24,6 +24,7 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any, Final
 
+from thermocal.data_units import signal_in_data_unit
 from thermocal.errors import ConditioningWarning, ParameterError, ThermocalInputError, UnitWarning
 from thermocal.stability.allan import ONE_SIGMA_CONFIDENCE
 from thermocal.stability.edf import check_confidence
@@ -227,30 +228,6 @@ def column_unit(name: str) -> str:
     """
     hit = re.search(r"[\[(]([^\])]+)[\])]\s*$", name)
     return hit.group(1).strip() if hit else ""
-
-
-def signal_in_data_unit(rec: Recording, name: str) -> tuple[FloatArray, str]:
-    """The signal ``name`` in the data's own unit and that unit: the canonical values
-    divided by k of :func:`thermocal.metrics.data_unit_of` (the canonical array itself when
-    k = 1, so a caller may overwrite it).
-
-    Parameters
-    ----------
-    rec : Recording
-        The recording.
-    name : str
-        Signal name.
-
-    Returns
-    -------
-    tuple of (numpy.ndarray, str)
-        Values [unit] and the unit.
-    """
-    from thermocal.metrics import data_unit_of
-
-    canonical, canon_unit = rec.signal(name)
-    unit, k = data_unit_of(rec, name, canon_unit)
-    return (canonical if k == 1.0 else canonical / k), unit
 
 
 @dataclass(frozen=True, eq=False)
