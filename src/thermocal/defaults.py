@@ -45,6 +45,7 @@ SCENARIO_NAMES: Final = (
     "mems-imu",
     "multipos",
     "ratetable",
+    "thermal-lag",
 )
 """The simulator's scenarios (:data:`thermocal.simulate.SCENARIOS`, a test checks they agree)."""
 

@@ -378,6 +378,7 @@ def test_scenario_registry_and_bad_input() -> None:
         "mems-imu",
         "multipos",
         "ratetable",
+        "thermal-lag",
     }
     with pytest.raises(ThermocalInputError, match="unknown scenario"):
         run_scenario("nope", 0)
