@@ -43,7 +43,7 @@ import numpy as np
 from thermocal.adequacy import Needs
 from thermocal.errors import DesignError, ModelFileError, ThermocalInputError
 from thermocal.families import HYST, FamilyDeclaration
-from thermocal.models.base import ModelStream, TemperatureModel
+from thermocal.models.base import ChunkContext, ModelStream, TemperatureModel
 from thermocal.models.checks import (
     boolean,
     fields,
@@ -119,6 +119,15 @@ class HystModel(TemperatureModel):
         self.order = order
         self.tau_s = tau_s
         self.tau_max_s = tau_max_s
+
+    LAG_MEMORY: ClassVar[float] = 40.0
+    """History before a chunk, in time constants: the lag restarted there forgets its
+    starting error by e^−40 ≈ 4e−18, below a double's resolution of the temperature."""
+
+    def chunk_context(self) -> ChunkContext:
+        """40 τ of history before a chunk (:attr:`LAG_MEMORY`): the same values as the whole
+        record's lag to the last bit of a double."""
+        return ChunkContext(head_s=0.0, tail_s=self.LAG_MEMORY * float(getattr(self, "tau_", 0.0)))
 
     def data_needs(self, temp_names: Sequence[str], n_runs: int) -> Needs:
         """The polynomial's order in the first temperature column; p + 1 coefficients and
