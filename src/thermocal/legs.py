@@ -6,7 +6,7 @@ monotonically beyond its noise, with holds or reversals between legs.  The legs 
 by a hysteresis quantiser of the temperature (:func:`find_legs`): starting from the first
 sample, an *event* is recorded each time the temperature has moved by the threshold
 
-.. math:: h = \max(5\,\sigma_T,\; 2.5\,q,\; s_\mathrm{min}/10)
+.. math:: h = \max(8\,\sigma_T,\; 2.5\,q,\; s_\mathrm{min}/10)
 
 from the last event's value (:math:`\sigma_T` the white noise of the reading from the median
 absolute deviation of its first differences, :math:`q` the thermometer's lattice step from
@@ -57,8 +57,10 @@ Direction = Literal["heating", "cooling"]
 
 MIN_SPAN_C: Final = 1.0
 """The smallest temperature change of a leg [°C] (a chamber's legs span tens of °C)."""
-NOISE_FACTOR: Final = 5.0
-"""The event threshold in units of the reading's white noise σ_T."""
+NOISE_FACTOR: Final = 8.0
+"""The event threshold in units of the reading's white noise σ_T: the difference of two
+noisy readings has σ_T √2, and 8 σ_T ≈ 5.7 of its σ, which a hold of 10⁶ samples does not
+reach by chance."""
 LATTICE_FACTOR: Final = 2.5
 """The event threshold in lattice steps q: a toggle between two levels (q) or three (2q)
 is no movement."""
@@ -280,18 +282,17 @@ def _leg_ends(v: FloatArray, idx: list[int], run: tuple[int, int], sign: int) ->
     i1, im = idx[run[0]], idx[run[1]]
     p = idx[run[0] - 1] if run[0] > 0 else 0
     q = idx[run[1] + 1] if run[1] + 1 < len(idx) else v.size
-    before = v[p:i1]
-    start = p
-    if before.size:
-        a0 = float(np.median(before))
-        at = np.flatnonzero(sign * (before - a0) <= 0)
+    # the levels from the stretches beyond the run's events; the crossings searched over
+    # the whole run (a noisy reading may make its last event late in the hold after)
+    start, end = p, im
+    if i1 > p:
+        a0 = float(np.median(v[p:i1]))
+        at = np.flatnonzero(sign * (v[p : im + 1] - a0) <= 0)
         start = p + int(at[-1]) if at.size else p
-    after = v[im:q]
-    end = im
-    if after.size:
-        a1 = float(np.median(after))
-        at = np.flatnonzero(sign * (after - a1) >= 0)
-        end = im + int(at[0]) if at.size else im
+    if q > im:
+        a1 = float(np.median(v[im:q]))
+        at = np.flatnonzero(sign * (v[i1:q] - a1) >= 0)
+        end = i1 + int(at[0]) if at.size else im
     return start, end
 
 
@@ -317,7 +318,7 @@ def find_legs(
 
     Notes
     -----
-    Event threshold :math:`h = \max(5\sigma_T, 2.5q, s_\mathrm{min}/10)`; a leg is a run of
+    Event threshold :math:`h = \max(8\sigma_T, 2.5q, s_\mathrm{min}/10)`; a leg is a run of
     same-direction events without a pause longer than 5 typical intervals, spanning at
     least :math:`\max(s_\mathrm{min}, 4h)`.
 

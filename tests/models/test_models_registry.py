@@ -13,11 +13,11 @@ from thermocal.families import BUILTIN_FAMILIES, MODEL_FAMILIES, POLY
 from thermocal.models import registry
 from thermocal.models.bank import BankModel
 from thermocal.models.format import checksum, model_file_dict
+from thermocal.models.hyst import HystModel
 from thermocal.models.piecewise import PiecewiseModel
 from thermocal.models.poly import PolyModel
 from thermocal.models.rundata import RunData
 from thermocal.models.schema import verify_model_dict
-from thermocal.models.hyst import HystModel
 from thermocal.models.warmup import WarmupModel
 
 
