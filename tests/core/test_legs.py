@@ -4,6 +4,7 @@ heating-vs-cooling test against a difference and a t written here."""
 
 from __future__ import annotations
 
+import itertools
 import math
 
 import numpy as np
@@ -51,8 +52,9 @@ def test_an_isothermal_record_has_no_leg_and_says_so() -> None:
     rng = np.random.default_rng(4)
     t = np.arange(0.0, 7200.0)
     # a thermometer toggling between two and three levels of 0.125 °C, and a noisy one
-    for temp in (25.0 + 0.125 * rng.integers(0, 2, t.size), 25.0 + 0.125 * rng.integers(-1, 2, t.size),
-                 25.0 + 0.05 * rng.standard_normal(t.size)):  # fmt: skip
+    two = 25.0 + 0.125 * rng.integers(0, 2, t.size)
+    three = 25.0 + 0.125 * rng.integers(-1, 2, t.size)
+    for temp in (two, three, 25.0 + 0.05 * rng.standard_normal(t.size)):
         legs = find_legs(t, temp)
         assert legs.legs == ()
         assert legs.summary().startswith("no heating or cooling leg")
@@ -82,7 +84,7 @@ def test_legs_that_differ_disagree_with_the_difference_and_t_written_here() -> N
     lo, hi = max(temp[th].min(), temp[tc].min()), min(temp[th].max(), temp[tc].max())
     edges = np.linspace(lo, hi, 13)
     d = []
-    for a, b in zip(edges[:-1], edges[1:], strict=True):
+    for a, b in itertools.pairwise(edges):
         last = b == edges[-1]
         inb = (temp >= a) & ((temp <= b) if last else (temp < b))
         d.append(resid[inb & th].mean() - resid[inb & tc].mean())
