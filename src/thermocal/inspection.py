@@ -212,6 +212,10 @@ class Inspection:
         (:meth:`thermocal.thermometer.Thermometer.to_dict`: lattice step, update period,
         quantised, slow), None when it cannot be told (raw counts without a conversion, no
         finite value, time not increasing).
+    legs : dict
+        Per temperature column, its heating and cooling legs
+        (:meth:`thermocal.legs.Legs.to_dict` with a ``summary``), None when they cannot be
+        told (as ``thermometers``).
     """
 
     file: str
@@ -234,6 +238,8 @@ class Inspection:
     """The scatter of the time steps (:func:`thermocal.recording.time_jitter`)."""
     thermometers: dict[str, dict[str, Any] | None] = field(default_factory=dict)
     """Per temperature column, its thermometer (:mod:`thermocal.thermometer`)."""
+    legs: dict[str, dict[str, Any] | None] = field(default_factory=dict)
+    """Per temperature column, its heating and cooling legs (:mod:`thermocal.legs`)."""
 
     @property
     def fatal(self) -> list[Problem]:
@@ -271,6 +277,7 @@ class Inspection:
                 self.timestamp_jitter.to_dict() if self.timestamp_jitter is not None else None
             ),
             "thermometers": self.thermometers,
+            "legs": self.legs,
         }
 
 
@@ -509,7 +516,21 @@ def inspect_recording(rec: Recording, skipped: Sequence[str] = ()) -> Inspection
         time_ok=time_ok,
         timestamp_jitter=rec.time_jitter(),
         thermometers={n: _thermometer(rec, n) for n in span if time_ok and span[n] is not None},
+        legs={n: _legs(rec, n) for n in span if time_ok and span[n] is not None},
     )
+
+
+def _legs(rec: Recording, name: str) -> dict[str, Any] | None:
+    """The heating and cooling legs of column ``name`` with a summary line (None: no finite
+    value)."""
+    from thermocal.errors import ParameterError
+    from thermocal.legs import find_legs
+
+    try:
+        legs = find_legs(rec.time_s, rec.temperature_c(name))
+    except ParameterError:
+        return None
+    return {"summary": legs.summary(), **legs.to_dict()}
 
 
 def _thermometer(rec: Recording, name: str) -> dict[str, Any] | None:

@@ -217,14 +217,12 @@ def white_noise(x: FloatArray) -> float:
     return float(1.4826 * np.median(np.abs(d - np.median(d))) / math.sqrt(2.0))
 
 
-def _step_of(v: FloatArray) -> float | None:
-    """The reading's lattice step: :func:`~thermocal.thermometer.lattice_step`, else, when
-    most samples repeat the one before (a coarse reading whose holds outnumber its ramps'
-    levels), the median of the nonzero steps."""
-    if v.size < 2:
-        return None
-    q = lattice_step(v)
-    if q is not None:
+def _step_of(v: FloatArray, q: float | None) -> float | None:
+    """The reading's step: its lattice step ``q`` (:func:`~thermocal.thermometer.lattice_step`),
+    else, when most samples repeat the one before (a coarse reading whose holds outnumber
+    its ramps' levels, which the lattice test does not see), the median of the nonzero
+    steps."""
+    if v.size < 2 or q is not None:
         return q
     d = np.abs(np.diff(v))
     moved = d[d > 0]
@@ -345,9 +343,9 @@ def find_legs(
     k = max(1, math.ceil(keep.size / MAX_SAMPLES))
     keep = keep[::k]
     v, tv = x_all[keep], t_all[keep]
-    q = _step_of(v)
+    q = lattice_step(v) if v.size >= 2 else None
     sigma = white_noise(v)
-    h = max(NOISE_FACTOR * sigma, LATTICE_FACTOR * (q or 0.0), min_span_c / 10.0)
+    h = max(NOISE_FACTOR * sigma, LATTICE_FACTOR * (_step_of(v, q) or 0.0), min_span_c / 10.0)
     if v.size < 2:
         return Legs((), h, q, sigma, n)
     idx, sgn = _events(v.tolist(), h)

@@ -33,8 +33,8 @@ def test_legs_found_exactly_on_a_quantised_simulated_sweep(quant: float, noise: 
     assert [f[0] for f in found] == [w[0] for w in want] == ["heating", "cooling"]
     for (_, a, b), (_, ta, tb) in zip(found, want, strict=True):
         assert abs(a - ta) <= tol and abs(b - tb) <= tol, (found, want, tol)
-    if quant and not noise:
-        assert legs.lattice_step_c == pytest.approx(quant)
+    if quant and not noise:  # the lattice test misses it (holds outnumber the ramps' levels)
+        assert legs.threshold_c == pytest.approx(2.5 * quant)
 
 
 def test_holds_split_a_staircase_and_reversals_end_a_leg() -> None:

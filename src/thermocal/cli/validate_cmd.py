@@ -163,7 +163,35 @@ def _human_single(report: "_validate.ValidationReport") -> None:
         f"zero = {fmt(res.zero_reference)} {u}: {res.zero_reference_what}; the figures "
         "about the mean ignore a constant offset, those about zero do not"
     )
+    _human_legs(res)
     stdout.print(f"verdict: {res.verdict_line}")
+
+
+def _human_legs(res: "_validation.ValidationResult") -> None:
+    """The heating and cooling legs: each leg's figures after compensation, and whether
+    heating and cooling disagree beyond the noise, before and after."""
+    if res.legs is None or res.legs_after is None:
+        return
+    stdout.print(f"legs: {res.legs.summary()}")
+    if res.legs_after.per_leg:
+        table = _rich_table.Table(title=f"legs after compensation [{res.unit}], about the mean")
+        for col in ("leg", "time [s]", "T [°C]", "rate [°C/min]", "rms", "max |e|", "mean"):
+            table.add_column(col)
+        for f in res.legs_after.per_leg:
+            g = f.leg
+            table.add_row(
+                g.direction,
+                f"{g.start_s:.6g}…{g.stop_s:.6g}",
+                f"{g.temp_start_c:.4g}→{g.temp_stop_c:.4g}",
+                fmt(g.rate_c_per_min, 3),
+                fmt(f.rms),
+                fmt(f.max_abs),
+                fmt(f.mean),
+            )
+        stdout.print(table)
+    if res.legs_before is not None and res.legs_before.mean_difference is not None:
+        stdout.print(f"before: {res.legs_before.line()}")
+    stdout.print(f"after: {res.legs_after.line()}")
 
 
 def _human_triads(report: "_validate.ValidationReport") -> None:
