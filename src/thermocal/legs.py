@@ -457,9 +457,10 @@ class LegComparison:
         if self.mean_difference is None:
             return f"heating vs cooling: not compared ({self.reason})"
         word = "DISAGREE beyond the noise" if self.disagree else "agree within the noise"
+        ratio = f" ({self.mean_difference / self.noise:.2g} σ)" if self.noise > 0 else ""
         return (
             f"heating vs cooling: {word}: mean difference {self.mean_difference:.4g} "
-            f"{self.unit} over {self.n_bins} temperature bins, t = {self.t_statistic:.3g} "
+            f"{self.unit}{ratio} over {self.n_bins} temperature bins, t = {self.t_statistic:.3g} "
             f"(|t| > {self.t_critical:.3g} disagrees at {100 * CONFIDENCE:g} %), "
             f"noise σ {self.noise:.3g} {self.unit}"
         )

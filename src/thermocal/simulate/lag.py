@@ -77,7 +77,7 @@ def scenario_thermal_lag(
     *,
     rate_hz: float | None = None,
     lag_s: float = 300.0,
-    quant_c: float = 0.0,
+    quant_c: float = 0.0625,
     noise: float = 0.5,
     temp_noise_c: float = 0.0,
 ) -> ScenarioResult:
@@ -101,7 +101,7 @@ def scenario_thermal_lag(
     lag_s : float
         The die's lag τ [s].
     quant_c : float
-        The thermometer's resolution [°C] (0: continuous).
+        The thermometer's resolution [°C] (default 0.0625; 0: continuous).
     noise : float
         White noise σ of the gyro per sample [°/h].
     temp_noise_c : float
