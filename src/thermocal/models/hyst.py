@@ -85,8 +85,8 @@ class HystModel(TemperatureModel):
     ----------
     - X. Niu, Y. Li, H. Zhang, Q. Wang and Y. Ban, "Fast thermal calibration of low-grade
       inertial sensors and inertial measurement units", *Sensors* 13 (2013) 12192–12217.
-    - Kim, S. and Jung, J. (2025), thermal hysteresis of MEMS IMU bias between heating and
-      cooling (as cited by issue 44; docs/methods.md).
+    - Kim and Jung (2025), thermal hysteresis of a MEMS IMU's bias between heating and
+      cooling (docs/methods.md, [KimJung2025]).
 
     Examples
     --------
