@@ -92,7 +92,7 @@ def _cooling_only(path: Path) -> Path:
 
 def test_legs_heating_on_a_cooling_record_is_one_error_line(capsys, tmp_path: Path) -> None:
     f = _cooling_only(tmp_path / "cool.csv")
-    code, so, se = _run(capsys, ["fit", str(f), "--model", "hyst", "--signal", "gyro",
+    code, _, se = _run(capsys, ["fit", str(f), "--model", "hyst", "--signal", "gyro",
                                  "--legs", "heating", "-o", str(tmp_path / "m.json")])  # fmt: skip
     assert code == 2
     lines = [ln for ln in se.splitlines() if ln.strip()]

@@ -371,6 +371,8 @@ class HystStream(ModelStream):
         lo, hi = (float(v) for v in model.temp_range_[0])
         self._clamp = ClampOnce(lo, hi, extrapolate=extrapolate)
         self._tau = float(model.tau_)
+        self._coef = [float(v) for v in model.coef_]
+        self._centre, self._scale = float(model.centre_), float(model.scale_)
         self.reset()
 
     def reset(self) -> None:
@@ -409,5 +411,8 @@ class HystStream(ModelStream):
                 c = -math.expm1(-q) / q
                 z = e * z + (1.0 - c) * x + (c - e) * self._x
         self._z, self._t, self._x = z, time_s, x
-        m = self.model
-        return float(horner(m.coef_, np.float64((z - m.centre_) / m.scale_)))
+        u = (z - self._centre) / self._scale
+        y = self._coef[-1]  # Horner's rule, the operations of numerics.horner
+        for c in self._coef[-2::-1]:
+            y = y * u + c
+        return y

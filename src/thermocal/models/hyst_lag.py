@@ -211,7 +211,15 @@ def fit_at(
     dof = max(y.size - (order + 1), 1)
     cov = np.linalg.pinv(v.T @ v) * (rss / dof)
     cond = float(sv[0] / sv[-1]) if sv[-1] > 0 else math.inf
-    return LagFit(float(tau_s), coef, cov, rss, int(y.size), cond, resid)
+    return LagFit(
+        float(tau_s),
+        np.asarray(coef, dtype=np.float64),
+        np.asarray(cov, dtype=np.float64),
+        rss,
+        int(y.size),
+        cond,
+        resid,
+    )
 
 
 def _lag1(r: FloatArray) -> float:
