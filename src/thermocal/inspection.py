@@ -515,9 +515,20 @@ def inspect_recording(rec: Recording, skipped: Sequence[str] = ()) -> Inspection
         problems=problems + _skipped_problems(skipped),
         time_ok=time_ok,
         timestamp_jitter=rec.time_jitter(),
-        thermometers={n: _thermometer(rec, n) for n in span if time_ok and span[n] is not None},
-        legs={n: _legs(rec, n) for n in span if time_ok and span[n] is not None},
+        **_temperature_facts(rec, span, time_ok),
     )
+
+
+def _temperature_facts(
+    rec: Recording, span: dict[str, list[float] | None], time_ok: bool
+) -> dict[str, dict[str, dict[str, Any] | None]]:
+    """``thermometers`` and ``legs`` of each temperature column with a span, when time is
+    usable."""
+    names = [n for n in span if time_ok and span[n] is not None]
+    return {
+        "thermometers": {n: _thermometer(rec, n) for n in names},
+        "legs": {n: _legs(rec, n) for n in names},
+    }
 
 
 def _legs(rec: Recording, name: str) -> dict[str, Any] | None:

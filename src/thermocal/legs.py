@@ -149,11 +149,32 @@ class Legs:
     n_samples: int
 
     def of(self, direction: Direction) -> tuple[Leg, ...]:
-        """The legs of one direction."""
+        """The legs of one direction.
+
+        Parameters
+        ----------
+        direction : {"heating", "cooling"}
+            Which legs.
+
+        Returns
+        -------
+        tuple of Leg
+        """
         return tuple(g for g in self.legs if g.direction == direction)
 
     def mask(self, direction: Direction) -> npt.NDArray[np.bool_]:
-        """True on the samples of the legs of ``direction``, shape (n_samples,)."""
+        """True on the samples of the legs of ``direction``.
+
+        Parameters
+        ----------
+        direction : {"heating", "cooling"}
+            Which legs.
+
+        Returns
+        -------
+        numpy.ndarray of bool
+            Shape (n_samples,).
+        """
         out = np.zeros(self.n_samples, dtype=bool)
         for g in self.of(direction):
             out[g.start : g.stop] = True
@@ -441,7 +462,20 @@ class LegComparison:
         return bool(abs(self.t_statistic) > self.t_critical)
 
     def scaled(self, unit: str, factor: float) -> LegComparison:
-        """The same in another unit (``value[self.unit] = factor · value[unit]``)."""
+        """The same in another unit.
+
+        Parameters
+        ----------
+        unit : str
+            The new unit.
+        factor : float
+            ``value[self.unit] = factor · value[unit]``.
+
+        Returns
+        -------
+        LegComparison
+            Every figure divided by ``factor``; t and the bins unchanged.
+        """
         legs = tuple(
             LegFigures(f.leg, f.rms / factor, f.max_abs / factor, f.mean / factor)
             for f in self.per_leg

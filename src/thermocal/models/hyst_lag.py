@@ -171,7 +171,20 @@ class LagFit:
 def lagged_runs(
     times: Sequence[FloatArray], temps: Sequence[FloatArray], tau_s: float
 ) -> FloatArray:
-    """Each run's lagged temperature (each from its own first sample), concatenated [°C]."""
+    """Each run's lagged temperature (each from its own first sample), concatenated.
+
+    Parameters
+    ----------
+    times, temps : sequence of numpy.ndarray
+        Each run's times [s] and reading [°C].
+    tau_s : float
+        The lag τ [s].
+
+    Returns
+    -------
+    numpy.ndarray
+        z [°C] of every sample, run after run.
+    """
     return np.concatenate([first_order_lag(t, x, tau_s) for t, x in zip(times, temps, strict=True)])
 
 
