@@ -64,9 +64,11 @@ def test_fit_on_heating_validate_reports_each_leg(capsys, sweep: Path, tmp_path:
     assert p["mean_difference"] == pytest.approx(-10.5, abs=1.0)  # 2 °/h/°C × 5 °C lag
     assert abs(p["t_statistic"]) > p["t_critical"]
     assert hashlib.sha256(sweep.read_bytes()).hexdigest() == digest  # input untouched
-    code, so, _ = _run(capsys, ["validate", str(tmp_path / "p.json"), str(sweep)])
+    code, so, _ = _run(capsys, ["validate", str(tmp_path / "p.json"), str(sweep), "--legs"])
     assert "heating vs cooling: DISAGREE beyond the noise" in so
     assert "legs: 1 heating and 1 cooling legs" in so
+    code, so, _ = _run(capsys, ["validate", str(tmp_path / "p.json"), str(sweep)])
+    assert "heating vs cooling" not in so  # the text tables with --legs only
 
 
 def test_inspect_lists_the_legs(capsys, sweep: Path) -> None:
@@ -120,5 +122,5 @@ def test_an_isothermal_record_validates_and_says_it_has_no_leg(capsys, tmp_path:
     assert legs["legs"] == [] and legs["disagree"] is None
     assert legs["summary"].startswith("no heating or cooling leg")
     assert legs["reason"] == "no heating leg"
-    code, so, _ = _run(capsys, ["inspect", str(iso)])
-    assert "temperature 'T1': no heating or cooling leg" in so
+    code, so, _ = _run(capsys, ["inspect", str(iso), "--json"])
+    assert json.loads(so)["legs"]["T1"]["summary"].startswith("no heating or cooling leg")

@@ -91,6 +91,7 @@ def test_legs_that_differ_disagree_with_the_difference_and_t_written_here() -> N
     d = np.array(d)
     t_here = d.mean() / (d.std(ddof=1) / math.sqrt(d.size))
     assert cmp.n_bins == 12
+    assert cmp.t_critical == pytest.approx(3.106, abs=1e-3)  # Student's t table, 0.995, 11 dof
     assert cmp.mean_difference == pytest.approx(d.mean(), rel=1e-9)
     assert cmp.t_statistic == pytest.approx(t_here, rel=1e-9)
     assert cmp.mean_difference == pytest.approx(1.6, abs=0.15)  # 2 × 0.8

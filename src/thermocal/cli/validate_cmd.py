@@ -90,6 +90,16 @@ StaticSOpt = Annotated[
         help="A multi-position calibration's held-out session: shortest still pose [s].",
     ),
 ]
+LegsReportOpt = Annotated[
+    bool,
+    typer.Option(
+        "--legs",
+        help="Print each heating and cooling leg of the ambient temperature with the "
+        "compensated output's rms, largest error and mean on it, and whether heating and "
+        "cooling disagree at equal temperature beyond the noise (thermal hysteresis); "
+        "--json always holds them.",
+    ),
+]
 SettleOpt = Annotated[
     float, typer.Option("--settle", help="Seconds cut from the start of each stage.")
 ]
@@ -118,7 +128,7 @@ def _human_channels(report: "_validate.ValidationReport") -> None:
     stdout.print(table)
 
 
-def _human_single(report: "_validate.ValidationReport") -> None:
+def _human_single(report: "_validate.ValidationReport", legs: bool = False) -> None:
     """One channel: the figures before and after, the zero reference and the verdict."""
     ch = report.channels[0]
     res, out, model, file = ch.result, ch.figures, ch.model, report.file
@@ -163,7 +173,8 @@ def _human_single(report: "_validate.ValidationReport") -> None:
         f"zero = {fmt(res.zero_reference)} {u}: {res.zero_reference_what}; the figures "
         "about the mean ignore a constant offset, those about zero do not"
     )
-    _human_legs(res)
+    if legs:
+        _human_legs(res)
     stdout.print(f"verdict: {res.verdict_line}")
 
 
@@ -243,16 +254,17 @@ def validate_cmd(
     stamp: StampOpt = "header",
     latitude: TurntableLatitudeOpt = None,
     static_s: StaticSOpt = 1.0,
+    legs: LegsReportOpt = False,
     as_json: JsonOpt = False,
 ) -> None:
     """Validate MODEL on FILE: correlation r, bias stability and repeatability over the
     hold stages, rms and peak-to-peak, before and after compensation; a calibration of
     triads (thermocal turntable over temperature) on a turntable run: dwell-mean and
-    move-angle errors before and after."""
+    move-angle errors before and after; with --legs each heating and cooling leg."""
     report = _validate.validate_files(model_file, file, options_of(ValidateOptions, locals()))
     if report.triads:
         emit(report.to_dict(), as_json, lambda: _human_triads(report))
     elif report.several:
         emit(report.to_dict(), as_json, lambda: _human_channels(report))
     else:
-        emit(report.to_dict(), as_json, lambda: _human_single(report))
+        emit(report.to_dict(), as_json, lambda: _human_single(report, legs))

@@ -435,7 +435,7 @@ def inspection_text(r: Inspection) -> list[Block]:
     """What a recording holds: samples, duration, sample rate, gaps and segments (or why
     they are not computed), a table of each column's role, unit, range, mean, NaN and
     spikes, a quantised or slow thermometer, each temperature's heating and cooling legs
-    (the first ten), and the first ten gaps.
+    when it has any (the first ten), and the first ten gaps.
 
     Parameters
     ----------
@@ -469,8 +469,8 @@ def inspection_text(r: Inspection) -> list[Block]:
                 f"temperature {name!r}: the thermometer is {th['kind']}; fit, px4-tempcal "
                 "and ardupilot-tempcal fit on the temperature reconstructed at each sample"
             )
-    for name, lg in r.legs.items():
-        if lg is not None:
+    for name, lg in r.legs.items():  # a record without a leg: said in the JSON only
+        if lg is not None and lg["legs"]:
             shown = ", ".join(
                 f"{g['direction']} {g['start_s']:.6g}…{g['stop_s']:.6g} s "
                 f"({g['temp_start_c']:.4g}→{g['temp_stop_c']:.4g} °C)"
