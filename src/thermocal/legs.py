@@ -191,7 +191,7 @@ class Legs:
         return f"{h} heating and {c} cooling leg{'s' if h + c != 1 else ''}"
 
     def to_dict(self) -> dict[str, Any]:
-        """JSON-ready dict (``inspect --json``'s ``legs``)."""
+        """JSON-ready dict (the ``legs`` of the inspect command's JSON)."""
         return {
             "n_heating": len(self.of("heating")),
             "n_cooling": len(self.of("cooling")),
@@ -500,7 +500,7 @@ class LegComparison:
         )
 
     def to_dict(self) -> dict[str, Any]:
-        """JSON-ready dict (``validate --json``'s ``legs``)."""
+        """JSON-ready dict (the ``legs`` of the validate command's JSON)."""
         return {
             "legs": [f.to_dict() for f in self.per_leg],
             "mean_difference": _opt(self.mean_difference),

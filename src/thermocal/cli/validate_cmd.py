@@ -97,7 +97,7 @@ LegsReportOpt = Annotated[
         help="Print each heating and cooling leg of the ambient temperature with the "
         "compensated output's rms, largest error and mean on it, and whether heating and "
         "cooling disagree at equal temperature beyond the noise (thermal hysteresis); "
-        "--json always holds them.",
+        "the JSON output holds them in any case.",
     ),
 ]
 SettleOpt = Annotated[

@@ -12,7 +12,7 @@ range, ``z`` its lag from ``z = T`` at the first sample (exact first-order hold,
 width of the fitted range.  τ is given (``tau_s``) or fitted by a 1-D search minimising the
 residual sum of squares (:func:`thermocal.models.hyst_lag.search_tau`), with its standard
 error from the curvature of that sum.  A model fitted on heating alone and applied on
-cooling (``fit --legs heating``, then ``validate``) is the check of the lag: the two legs'
+cooling (the fit's ``legs`` option, then a validation) is the check of the lag: the two legs'
 residuals agree when τ is right.
 
 Model-file ``state`` layout (``"layout": "thermocal-hyst-1"``), for the C export::
@@ -200,9 +200,11 @@ class HystModel(TemperatureModel):
             longest = max(float(t[-1] - t[0]) for t in times)
             upper = float(self.tau_max_s) if self.tau_max_s else 0.5 * longest
             if not upper > step:
-                raise DesignError(
+                raise DesignError.naming(
                     f"hyst: the lag search needs an upper bound above the sample interval "
-                    f"{step:.3g} s, got {upper:.3g} s (give --tau-max or --tau)"
+                    f"{step:.3g} s, got {upper:.3g} s (give {{tau_max_s}} or {{tau_s}})",
+                    "tau_max_s",
+                    "tau_s",
                 )
             best, sigma = search_tau(times, temps, y, int(self.order), cs, (step, upper))
             fitted = True

@@ -933,7 +933,7 @@ def _legs_of(
 ) -> list[tuple[Path, _recording.Recording]]:
     """``o.legs`` heating or cooling: each run cut into its legs of that direction
     (:func:`thermocal.legs.find_legs` on the first fitted temperature), each leg a run;
-    refused, naming ``--legs``, when no file has such a leg."""
+    refused, naming ``legs``, when no file has such a leg."""
     if o.legs == "all":
         return loaded
     from thermocal.legs import find_legs

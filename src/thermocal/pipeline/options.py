@@ -264,6 +264,9 @@ class ValidateOptions:
         Test-site latitude [°] of a turntable run judging a triad calibration.
     static_s : float
         A multi-position calibration's held-out session: shortest still pose [s].
+    legs : bool
+        The command's text shows each heating and cooling leg (the result holds them in
+        any case: :attr:`thermocal.validation.ValidationResult.legs_after`).
 
     Raises
     ------
@@ -301,6 +304,7 @@ class ValidateOptions:
     stamp: Literal["header", "receive"] = "header"
     latitude: float | None = None
     static_s: float = 1.0
+    legs: bool = False
 
     def __post_init__(self) -> None:
         set_ = object.__setattr__  # frozen: normalise in place once

@@ -73,7 +73,7 @@ def generate(ctx: ExportContext) -> FamilyCode:
         "s->last_t = time_s;",
         "s->last_x = x;",
         f"u = ({r})((s->z - {P}_CENTRE) / {P}_SCALE);",
-        f"for (j = {P}_ORDER - 1; j >= 0; --j) {{",
+        f"for (j = {P}_ORDER - 1; j >= 0; j -= 1) {{",
         f"    y = y * u + {P}_A[j];",
         "}",
         "return y;",
