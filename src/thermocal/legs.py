@@ -360,9 +360,9 @@ def find_legs(
     t_all = np.asarray(time_s, dtype=np.float64)
     x_all = np.asarray(temp_c, dtype=np.float64)
     n = int(x_all.size)
-    keep = np.flatnonzero(np.isfinite(x_all) & np.isfinite(t_all))
-    k = max(1, math.ceil(keep.size / MAX_SAMPLES))
-    keep = keep[::k]
+    k = max(1, math.ceil(n / MAX_SAMPLES))  # every k-th sample: no full-size copy
+    t_k, x_k = t_all[::k], x_all[::k]
+    keep = np.flatnonzero(np.isfinite(x_k) & np.isfinite(t_k)) * k
     v, tv = x_all[keep], t_all[keep]
     q = lattice_step(v) if v.size >= 2 else None
     sigma = white_noise(v)
