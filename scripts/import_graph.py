@@ -27,7 +27,7 @@ LAYERS: dict[str, int] = {
     "_lazy": 1, "_version": 1, "errors": 1, "defaults": 1, "units": 1, "identifiers": 1, "outputs": 1,
     "recording": 1, "families": 1, "data_units": 1,
     # 2 maths: pure functions on arrays
-    "preprocess": 2, "thermometer": 2, "metrics": 2, "profiles": 2, "inspection": 2, "adequacy": 2, "gravity": 2,
+    "preprocess": 2, "thermometer": 2, "legs": 2, "metrics": 2, "profiles": 2, "inspection": 2, "adequacy": 2, "gravity": 2,
     "heater": 2,
     "stability": 2, "models": 2, "compensate.kernels": 2, "simulate": 2, "turntable": 2,
     "multipos": 2, "datasets": 2, "compensate": 2, "firmware": 2, "metrics_streaming": 2,

@@ -46,6 +46,7 @@ SCENARIO_NAMES: Final = (
     "multipos",
     "ratetable",
     "tumble",
+    "thermal-lag",
 )
 """The simulator's scenarios (:data:`thermocal.simulate.SCENARIOS`, a test checks they agree)."""
 

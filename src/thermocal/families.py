@@ -14,7 +14,7 @@ Examples
 --------
 >>> from thermocal.families import BUILTIN_FAMILIES, MODEL_FAMILIES
 >>> MODEL_FAMILIES
-('poly', 'piecewise', 'warmup', 'bank')
+('poly', 'piecewise', 'warmup', 'bank', 'hyst')
 >>> order = next(o for o in BUILTIN_FAMILIES[0].options if o.name == "order")
 >>> order.check(3), order.kind
 (3, 'int')
@@ -319,7 +319,31 @@ BANK: Final = FamilyDeclaration(
 )
 """``bank``: :class:`thermocal.models.bank.BankModel`."""
 
-BUILTIN_FAMILIES: Final = (POLY, PIECEWISE, WARMUP, BANK)
+HYST: Final = FamilyDeclaration(
+    "hyst",
+    "thermocal.models.hyst:HystModel",
+    "thermal hysteresis: polynomial in the die temperature, a first-order lag τ of T",
+    (
+        FamilyOption("order", "int", "order in the lagged temperature", 1, MAX_ORDER),
+        FamilyOption(
+            "tau_s", "float", "the lag τ held fixed [s] (default: fitted)", 0.0, option="tau"
+        ),
+        FamilyOption(
+            "tau_max_s",
+            "float",
+            "upper bound of the lag search [s] (default half the record)",
+            0.0,
+            lo_open=True,
+            option="tau_max",
+        ),
+    ),
+    "the polynomial's order in its temperature column and the lag τ; a record that heats "
+    "and cools (or changes rate) to tell τ apart",
+    "thermocal.export.c.hyst",
+)
+"""``hyst``: :class:`thermocal.models.hyst.HystModel`."""
+
+BUILTIN_FAMILIES: Final = (POLY, PIECEWISE, WARMUP, BANK, HYST)
 """The built-in families, one registration each, in the order the ``fit`` command's help
 lists them."""
 
@@ -359,6 +383,7 @@ __all__ = [
     "BANK",
     "BUILTIN_FAMILIES",
     "ENTRY_POINT_GROUP",
+    "HYST",
     "MAX_ORDER",
     "MAX_SEGMENTS",
     "MAX_TERMS",

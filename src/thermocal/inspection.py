@@ -212,6 +212,10 @@ class Inspection:
         (:meth:`thermocal.thermometer.Thermometer.to_dict`: lattice step, update period,
         quantised, slow), None when it cannot be told (raw counts without a conversion, no
         finite value, time not increasing).
+    legs : dict
+        Per temperature column, its heating and cooling legs
+        (:meth:`thermocal.legs.Legs.to_dict` with a ``summary``), None when they cannot be
+        told (as ``thermometers``).
     """
 
     file: str
@@ -234,6 +238,8 @@ class Inspection:
     """The scatter of the time steps (:func:`thermocal.recording.time_jitter`)."""
     thermometers: dict[str, dict[str, Any] | None] = field(default_factory=dict)
     """Per temperature column, its thermometer (:mod:`thermocal.thermometer`)."""
+    legs: dict[str, dict[str, Any] | None] = field(default_factory=dict)
+    """Per temperature column, its heating and cooling legs (:mod:`thermocal.legs`)."""
 
     @property
     def fatal(self) -> list[Problem]:
@@ -271,6 +277,7 @@ class Inspection:
                 self.timestamp_jitter.to_dict() if self.timestamp_jitter is not None else None
             ),
             "thermometers": self.thermometers,
+            "legs": self.legs,
         }
 
 
@@ -378,17 +385,6 @@ def count_spikes(
     return n_total, first
 
 
-def _temperature_span_c(rec: Recording, name: str) -> list[float] | None:
-    """[min, max] of a temperature column in °C (raw counts converted when the
-    metadata gives a conversion; otherwise None)."""
-    try:
-        temp = rec.temperature_c(name)
-    except ThermocalInputError:
-        return None
-    ext = finite_extrema(temp)  # in blocks: no copy of the column
-    return [ext.lo, ext.hi] if ext is not None else None
-
-
 def _saturation_problems(name: str, arr: FloatArray) -> list[Problem]:
     """A warning for a signal column with samples on its rails: count, value, first row
     and the number of stretches."""
@@ -463,6 +459,7 @@ def inspect_recording(rec: Recording, skipped: Sequence[str] = ()) -> Inspection
     columns = {n: done[n][0] for n in names}
     span = {n: done[n][2] for n in names if done[n][0].role == "temperature"}
     thermometers = {n: done[n][3] for n in span if time_ok and span[n] is not None}
+    legs = {n: done[n][4] for n in thermometers}
     return Inspection(
         file=rec.name,
         n_samples=rec.n_samples,
@@ -477,15 +474,16 @@ def inspect_recording(rec: Recording, skipped: Sequence[str] = ()) -> Inspection
         time_ok=time_ok,
         timestamp_jitter=rec.time_jitter(),
         thermometers=thermometers,
+        legs=legs,
     )
 
 
 def _column_summary(
     rec: Recording, name: str, time_ok: bool
-) -> tuple[ColumnSummary, list[Problem], list[float] | None, dict[str, Any] | None]:
+) -> tuple[ColumnSummary, list[Problem], list[float] | None, dict[str, Any] | None, Any]:
     """One column's summary, its spike and rail problems, and for a temperature its span
-    [°C] and its thermometer (None when the span is None or the time is not usable), all
-    from one read of the column."""
+    [°C], its thermometer and its legs (None when the span is None or the time is not
+    usable), all from one read of the column (and one of it in °C)."""
     t, arr = rec.time_s, rec.columns[name]
     role = (
         "signal" if name in rec.signals else "temperature" if name in rec.temperatures else "other"
@@ -521,18 +519,50 @@ def _column_summary(
         n_spikes=n_spikes,
     )
     del nan, finite
-    span = _temperature_span_c(rec, name) if role == "temperature" else None
-    thermometer = _thermometer(rec, name) if time_ok and span is not None else None
-    return summary, problems, span, thermometer
+    span, thermometer, legs = (
+        _temperature_facts(rec, name, time_ok) if role == "temperature" else (None, None, None)
+    )
+    return summary, problems, span, thermometer, legs
 
 
-def _thermometer(rec: Recording, name: str) -> dict[str, Any] | None:
-    """What the thermometer of column ``name`` is (None: no finite value)."""
+def _temperature_facts(
+    rec: Recording, name: str, time_ok: bool
+) -> tuple[list[float] | None, dict[str, Any] | None, dict[str, Any] | None]:
+    """A temperature column's span [°C] (None: raw counts without a conversion, or no finite
+    value), its thermometer and its heating and cooling legs (None without a span or a
+    usable time), from one read of it in °C."""
+    try:
+        temp = rec.temperature_c(name)
+    except ThermocalInputError:
+        return None, None, None
+    ext = finite_extrema(temp)  # in blocks: no copy of the column
+    if ext is None:
+        return None, None, None
+    if not time_ok:
+        return [ext.lo, ext.hi], None, None
+    return [ext.lo, ext.hi], _thermometer(rec.time_s, temp), _legs(rec.time_s, temp)
+
+
+def _legs(t: FloatArray, temp_c: FloatArray) -> dict[str, Any] | None:
+    """The heating and cooling legs of a temperature [°C] with a summary line (None: no
+    finite value)."""
+    from thermocal.errors import ParameterError
+    from thermocal.legs import find_legs
+
+    try:
+        legs = find_legs(t, temp_c)
+    except ParameterError:
+        return None
+    return {"summary": legs.summary(), **legs.to_dict()}
+
+
+def _thermometer(t: FloatArray, temp_c: FloatArray) -> dict[str, Any] | None:
+    """What the thermometer of a temperature [°C] is (None: no finite value)."""
     from thermocal.errors import ParameterError
     from thermocal.thermometer import describe_thermometer
 
     try:
-        return describe_thermometer(rec.time_s, rec.temperature_c(name)).to_dict()
+        return describe_thermometer(t, temp_c).to_dict()
     except ParameterError:
         return None
 

@@ -39,7 +39,12 @@ not a copy of the modelling test's:
    by more than 1 % is *absolutely worse*: a warning, ``absolute_error_worse`` and the
    verdict ``NOT improved (absolute error worse)`` — the figures about the mean cannot see a
    constant offset the model adds (a model fitted at 13 °C applied at 47 °C).
-7. **Applicability**: the share of samples outside the model's calibrated temperature
+7. **Heating and cooling legs** of the ambient temperature (:func:`thermocal.legs.find_legs`):
+   each leg's rms, largest magnitude and mean of the output about its mean, before and
+   after, and whether heating and cooling disagree at equal temperature beyond the noise
+   (Student's t of the binned mean difference, :func:`thermocal.legs.compare_legs`) —
+   thermal hysteresis the model leaves.
+8. **Applicability**: the share of samples outside the model's calibrated temperature
    range (and Ṫ range, and time since power-on for warm-up models) and how far
    (:class:`~thermocal.models.ranges.RangeExcess`), one warning for the run.
 
@@ -77,6 +82,7 @@ from thermocal.errors import (
     ThermocalWarning,
     TimestampError,
 )
+from thermocal.legs import LegComparison, Legs, compare_legs, find_legs
 from thermocal.models.base import TemperatureModel
 from thermocal.models.ranges import (
     RANGE_WARNING_PATTERNS,
@@ -180,6 +186,11 @@ class ValidationResult:
         The absolute figures the compensation made worse (beyond 1 %).
     outside_range : tuple of RangeExcess
         How far the run leaves the model's calibrated ranges, per input.
+    legs : Legs or None
+        The heating and cooling legs of the ambient temperature (:func:`thermocal.legs.find_legs`).
+    legs_after, legs_before : LegComparison or None
+        Each leg's figures of the compensated (raw) output about its mean, and heating
+        against cooling at equal temperature (:func:`thermocal.legs.compare_legs`) [unit].
     """
 
     r: float | None
@@ -211,6 +222,12 @@ class ValidationResult:
     """The absolute figures the compensation made worse (beyond 1 %)."""
     outside_range: tuple[RangeExcess, ...] = ()
     """How far the run leaves the model's calibrated ranges, per input."""
+    legs: Legs | None = None
+    """The heating and cooling legs of the ambient temperature."""
+    legs_after: LegComparison | None = None
+    """Per leg, the compensated output about its mean, and heating vs cooling [unit]."""
+    legs_before: LegComparison | None = None
+    """The same of the raw output [unit]."""
 
     @property
     def absolute_error_worse(self) -> bool:
@@ -305,6 +322,10 @@ class ValidationResult:
             self,
             unit=unit,
             stages=stages,
+            legs_after=None if self.legs_after is None else self.legs_after.scaled(unit, factor),
+            legs_before=(
+                None if self.legs_before is None else self.legs_before.scaled(unit, factor)
+            ),
             absolute_before=absolute(self.absolute_before),
             absolute_after=absolute(self.absolute_after),
             zero_reference=self.zero_reference / factor,
@@ -358,8 +379,24 @@ class ValidationResult:
             ],
             "warnings": list(self.warnings),
         }
+        d["legs"] = self._legs_dict()
         d.update(self.extra)
         return d
+
+    def _legs_dict(self) -> dict[str, Any] | None:
+        """``legs`` of :meth:`to_dict`: the legs found, each leg's figures after
+        compensation, heating vs cooling after and before."""
+        if self.legs is None or self.legs_after is None:
+            return None
+        found = self.legs.to_dict()
+        after = self.legs_after.to_dict()
+        before = None if self.legs_before is None else self.legs_before.to_dict()
+        return {
+            "summary": self.legs.summary(),
+            **{k: v for k, v in found.items() if k != "legs"},
+            **after,
+            "before": None if before is None else {k: v for k, v in before.items() if k != "legs"},
+        }
 
 
 # --- pure figure functions -----------------------------------------------------------------
@@ -745,6 +782,12 @@ def _validate(
     rms_b, ptp_b = run_rms_and_peak_to_peak(t, before, averaging_s, tau0)
     rms_a, ptp_a = run_rms_and_peak_to_peak(t, after, averaging_s, tau0)
     ref, ref_what = zero_reference
+    legs = find_legs(t, amb)
+    unit = model.signal_unit
+    legs_after, legs_before = (
+        compare_legs(legs, amb, after, unit),
+        compare_legs(legs, amb, before, unit),
+    )
     abs_b, abs_a, worse = _absolute(
         before, after, ref, ref_what, where, display_unit or (model.signal_unit, 1.0), note
     )
@@ -772,6 +815,9 @@ def _validate(
         zero_reference_what=ref_what,
         absolute_worse=tuple(worse),
         outside_range=excess,
+        legs=legs,
+        legs_after=legs_after,
+        legs_before=legs_before,
     )
 
 

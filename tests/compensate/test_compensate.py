@@ -416,6 +416,9 @@ def _fit_family(fam: str) -> TemperatureModel:
             for r, tr in res
         ]
         m = make_model("bank").fit(runs)
+    elif fam == "hyst":
+        rec, _ = SCENARIOS["thermal-lag"](1)[0]
+        m = make_model("hyst").fit([RunData.from_recording(rec, "gyro", ["T1"])])
     else:  # pragma: no cover - a new family needs a fitter here
         raise AssertionError(f"no fitter for family {fam!r}")
     m.signal_name = "gyro"

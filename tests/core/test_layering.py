@@ -35,6 +35,7 @@ MATHS_MODULES = (
     "thermocal.recording",
     "thermocal.preprocess",
     "thermocal.metrics",
+    "thermocal.legs",
     "thermocal.metrics_streaming",
     "thermocal.profiles",
     "thermocal.inspection",

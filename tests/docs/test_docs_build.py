@@ -163,6 +163,13 @@ SOURCES = {
     r"RFC 4180": "RFC 4180",
     r"heater_params\.c": "heater_params.c",
     r"AP_BoardConfig\.cpp": "AP_BoardConfig.cpp",
+    r"Niu et al|X\. Niu": "X. Niu, Y. Li, H. Zhang, Q. Wang and Y. Ban",
+    r"Kim & Jung|Kim and Jung": "Kim and Jung (2025)",
+    r"Franklin": "G. F. Franklin, J. D. Powell and M. L. Workman",
+    r"Pereyra": "G. H. Golub and V. Pereyra",
+    r"Bayley": "G. V. Bayley and J. M. Hammersley",
+    r"R\. P\. Brent": "R. P. Brent",
+    r"Student 1908|Student, \"The probable": 'Student, "The probable error of a mean"',
 }
 """Every published source the package's code cites, and the methods chapter's entry for it."""
 

@@ -41,6 +41,7 @@ def test_every_tutorial_is_executed_here() -> None:
         "chamber-to-c.md",  # tests/docs/test_tutorials_a.py
         "fc-params.md",  # tests/docs/test_tutorials_b.py
         "firmware-learning.md",  # tests/docs/test_tutorial_firmware_learning.py
+        "hysteresis.md",  # tests/docs/test_tutorial_hysteresis.py
         "multipos-imucal.md",
         "noise-for-estimator.md",  # tests/docs/test_tutorials_a.py
         "notebook-allan.md",  # tests/docs/test_tutorial_notebook_allan.py

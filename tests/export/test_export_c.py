@@ -81,6 +81,13 @@ def _fit_piecewise(**params: Any) -> Callable[[], TemperatureModel]:
     return fit
 
 
+def _fit_hyst() -> TemperatureModel:
+    rec, _ = SCENARIOS["thermal-lag"](1, quant_c=0.0625)[0]
+    m = make_model("hyst", order=2).fit([RunData.from_recording(rec, "gyro", ["T1"])])
+    m.signal_name = "gyro"
+    return m
+
+
 FITTERS: dict[str, Callable[[], TemperatureModel]] = {
     "warmup": _fit_warmup,
     "bank": _fit_bank,
@@ -91,6 +98,7 @@ FITTERS: dict[str, Callable[[], TemperatureModel]] = {
     "piecewise": _fit_piecewise(),  # intersect method, breakpoints chosen from the data
     "piecewise-continuous": _fit_piecewise(method="continuous", breakpoints=[25.0, 30.0]),
     "piecewise-one-line": _fit_piecewise(segments=1),
+    "hyst": _fit_hyst,  # the lag's state across the gap and the clamping sweep
 }
 """Export cases: name → fitter (the family is the model's)."""
 

@@ -234,7 +234,7 @@ def test_a_broken_plugin_is_one_warning_and_skipped(tmp_path: Path) -> None:
     out = subprocess.run(
         [sys.executable, "-c", code], capture_output=True, text=True, env=env, check=True
     ).stdout.splitlines()
-    assert out[0] == "['bank', 'piecewise', 'poly', 'warmup']"
+    assert out[0] == "['bank', 'hyst', 'piecewise', 'poly', 'warmup']"
     assert out[1:] == [
         "model family plugin 'toy' (toyfam:NoSuchClass) skipped: AttributeError: module "
         "'toyfam' has no attribute 'NoSuchClass'"

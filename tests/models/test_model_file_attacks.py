@@ -1,6 +1,6 @@
 """Hostile model and calibration files through every command that reads one (issue 26).
 
-Real files are made here by ``thermocal fit`` (poly, piecewise, warmup, bank and a
+Real files are made here by ``thermocal fit`` (poly, piecewise, warmup, bank, hyst and a
 three-channel calibration) and by ``thermocal turntable`` over temperature (a calibration
 of triads), then mutated: NaN/Infinity/1e309 literals, 100 000-deep nesting, 5000-digit
 integers, empty and 2-D coefficients, a singular (I + E), a NaN or far TREF, wrong types,
@@ -80,6 +80,7 @@ def originals(tmp_path_factory: pytest.TempPathFactory) -> dict[str, tuple[bytes
     fits = {
         "poly": ["--model", "poly", "--order", "3", "--signal", "gyro_x"],
         "piecewise": ["--model", "piecewise", "--segments", "2", "--signal", "gyro_x"],
+        "hyst": ["--model", "hyst", "--order", "2", "--signal", "gyro_x"],
         "calibration": ["--model", "poly", "--order", "3", "--signal", "gyro_x,gyro_y,gyro_z"],
     }
     for kind, args in fits.items():
@@ -136,6 +137,7 @@ MODEL_AT: dict[str, Path_] = {
     "piecewise": (),
     "warmup": (),
     "bank": (),
+    "hyst": (),
     "calibration": ("channels", 0, "model"),
 }
 """Where the (first) single-channel model sits in each kind's file."""
@@ -145,6 +147,7 @@ NUMBER_AT: dict[str, Path_] = {
     "piecewise": ("state", "intercepts", 0),
     "warmup": ("state", "b", 0, 0),
     "bank": ("state", "models", 0, "values", 0),
+    "hyst": ("state", "coefficients", 0),
     "calibration": ("channels", 0, "model", "state", "coef", 1),
     "triads": ("triads", 0, "model", "tref_c"),
 }
@@ -155,6 +158,7 @@ ARRAY_AT: dict[str, Path_] = {
     "piecewise": ("state", "slopes"),
     "warmup": ("state", "b"),
     "bank": ("state", "models", 0, "values"),
+    "hyst": ("state", "coefficients"),
     "calibration": ("channels", 1, "model", "state", "coef"),
     "triads": ("triads", 0, "model", "parameters", 0, "coefficients"),
 }

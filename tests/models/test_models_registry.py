@@ -13,6 +13,7 @@ from thermocal.families import BUILTIN_FAMILIES, MODEL_FAMILIES, POLY
 from thermocal.models import registry
 from thermocal.models.bank import BankModel
 from thermocal.models.format import checksum, model_file_dict
+from thermocal.models.hyst import HystModel
 from thermocal.models.piecewise import PiecewiseModel
 from thermocal.models.poly import PolyModel
 from thermocal.models.rundata import RunData
@@ -29,13 +30,16 @@ def _line_run() -> RunData:
 
 def test_the_registry_lists_the_families_once_in_the_help_order() -> None:
     assert (
-        tuple(registry.MODEL_REGISTRY) == MODEL_FAMILIES == ("poly", "piecewise", "warmup", "bank")
+        tuple(registry.MODEL_REGISTRY)
+        == MODEL_FAMILIES
+        == ("poly", "piecewise", "warmup", "bank", "hyst")
     )
     assert {
         "poly": PolyModel,
         "piecewise": PiecewiseModel,
         "warmup": WarmupModel,
         "bank": BankModel,
+        "hyst": HystModel,
     } == registry.MODEL_REGISTRY
 
 
@@ -49,7 +53,9 @@ def test_a_family_record_is_what_its_class_declares() -> None:
     ]  # fmt: skip
     assert poly.declaration is POLY is PolyModel.declaration
     assert [f.name for f in registry.families()] == list(MODEL_FAMILIES)
-    with pytest.raises(ModelFileError, match="unknown model family 'nope'; known: bank, piecewise"):
+    with pytest.raises(
+        ModelFileError, match="unknown model family 'nope'; known: bank, hyst, piecewise"
+    ):
         registry.family("nope")
 
 

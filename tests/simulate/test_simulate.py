@@ -379,6 +379,7 @@ def test_scenario_registry_and_bad_input() -> None:
         "multipos",
         "ratetable",
         "tumble",
+        "thermal-lag",
     }
     with pytest.raises(ThermocalInputError, match="unknown scenario"):
         run_scenario("nope", 0)

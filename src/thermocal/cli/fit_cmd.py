@@ -296,6 +296,17 @@ TemperatureModeOpt = Annotated[
 ]
 
 
+LegsOpt = Annotated[
+    str,
+    typer.Option(
+        "--legs",
+        help="all: every sample; heating or cooling: only the legs where the first "
+        "temperature rises (falls) beyond its noise, each leg a run (thermal hysteresis: fit "
+        "on one leg, validate on the other).",
+    ),
+]
+
+
 KW = inspect.Parameter.KEYWORD_ONLY
 _EMPTY = inspect.Parameter.empty
 _COMMON_FIRST = (
@@ -315,7 +326,8 @@ _COMMON_LAST = (
     ("heater", HeaterOpt, "cut"), ("heater_setpoint", HeaterSetpointOpt, None),
     ("heater_band", HeaterBandOpt, 0.5), ("heater_min_hold", HeaterMinHoldOpt, 60.0),
     ("param", ParamOpt, None),
-    ("temperature", TemperatureModeOpt, "reconstructed"), ("as_json", JsonOpt, False),
+    ("temperature", TemperatureModeOpt, "reconstructed"), ("legs", LegsOpt, "all"),
+    ("as_json", JsonOpt, False),
 )  # fmt: skip
 """The options of ``fit`` every family shares, around the families' own."""
 

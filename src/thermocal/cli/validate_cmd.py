@@ -92,6 +92,16 @@ StaticSOpt = Annotated[
         help="A multi-position calibration's held-out session: shortest still pose [s].",
     ),
 ]
+LegsReportOpt = Annotated[
+    bool,
+    typer.Option(
+        "--legs",
+        help="Print each heating and cooling leg of the ambient temperature with the "
+        "compensated output's rms, largest error and mean on it, and whether heating and "
+        "cooling disagree at equal temperature beyond the noise (thermal hysteresis); "
+        "the JSON output holds them in any case.",
+    ),
+]
 SettleOpt = Annotated[
     float, typer.Option("--settle", help="Seconds cut from the start of each stage.")
 ]
@@ -120,7 +130,7 @@ def _human_channels(report: "_validate.ValidationReport") -> None:
     stdout.print(table)
 
 
-def _human_single(report: "_validate.ValidationReport") -> None:
+def _human_single(report: "_validate.ValidationReport", legs: bool = False) -> None:
     """One channel: the figures before and after, the zero reference and the verdict."""
     ch = report.channels[0]
     res, out, model, file = ch.result, ch.figures, ch.model, report.file
@@ -165,7 +175,36 @@ def _human_single(report: "_validate.ValidationReport") -> None:
         f"zero = {fmt(res.zero_reference)} {u}: {res.zero_reference_what}; the figures "
         "about the mean ignore a constant offset, those about zero do not"
     )
+    if legs:
+        _human_legs(res)
     stdout.print(f"verdict: {res.verdict_line}")
+
+
+def _human_legs(res: "_validation.ValidationResult") -> None:
+    """The heating and cooling legs: each leg's figures after compensation, and whether
+    heating and cooling disagree beyond the noise, before and after."""
+    if res.legs is None or res.legs_after is None:
+        return
+    stdout.print(f"legs: {res.legs.summary()}")
+    if res.legs_after.per_leg:
+        table = _rich_table.Table(title=f"legs after compensation [{res.unit}], about the mean")
+        for col in ("leg", "time [s]", "T [°C]", "rate [°C/min]", "rms", "max |e|", "mean"):
+            table.add_column(col)
+        for f in res.legs_after.per_leg:
+            g = f.leg
+            table.add_row(
+                g.direction,
+                f"{g.start_s:.6g}…{g.stop_s:.6g}",
+                f"{g.temp_start_c:.4g}→{g.temp_stop_c:.4g}",
+                fmt(g.rate_c_per_min, 3),
+                fmt(f.rms),
+                fmt(f.max_abs),
+                fmt(f.mean),
+            )
+        stdout.print(table)
+    if res.legs_before is not None and res.legs_before.mean_difference is not None:
+        stdout.print(f"before: {res.legs_before.line()}")
+    stdout.print(f"after: {res.legs_after.line()}")
 
 
 def _human_triads(report: "_validate.ValidationReport") -> None:
@@ -218,12 +257,13 @@ def validate_cmd(
     stamp: StampOpt = "header",
     latitude: TurntableLatitudeOpt = None,
     static_s: StaticSOpt = 1.0,
+    legs: LegsReportOpt = False,
     as_json: JsonOpt = False,
 ) -> None:
     """Validate MODEL on FILE: correlation r, bias stability and repeatability over the
     hold stages, rms and peak-to-peak, before and after compensation; a calibration of
     triads (thermocal turntable over temperature) on a turntable run: dwell-mean and
-    move-angle errors before and after."""
+    move-angle errors before and after; with --legs each heating and cooling leg."""
     given = {**locals(), "chamber_log": current_chamber_log()}
     report = _validate.validate_files(model_file, file, options_of(ValidateOptions, given))
     if report.triads:
@@ -231,4 +271,4 @@ def validate_cmd(
     elif report.several:
         emit(report.to_dict(), as_json, lambda: _human_channels(report))
     else:
-        emit(report.to_dict(), as_json, lambda: _human_single(report))
+        emit(report.to_dict(), as_json, lambda: _human_single(report, legs))

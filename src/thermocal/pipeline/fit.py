@@ -875,6 +875,7 @@ def fit_files(paths: Sequence[Path], options: FitOptions, output: Path) -> FitRe
     # the fit uses, and the reconstruction needs every sample (its update period)
     loaded, thermo = _thermometers(loaded, o)
     loaded, holds, said = _heater_holds(loaded, o)
+    loaded = _legs_of(loaded, o)
     spec = _FitSpec(o.model, family_options, o.temperatures, o.latitude, o.axis, o.known_input,
                     o.target, o.gravity_axis, g_local, o.tref,
                     _gravity.triad_gravity(loaded, names, o.gravity_axis, g_local),
@@ -943,6 +944,32 @@ def _heater_holds(
             holds[path.name] = judged.hold.to_dict()
         out.append((path, thinned))
     return out, holds, said
+
+
+def _legs_of(
+    loaded: list[tuple[Path, _recording.Recording]], o: FitOptions
+) -> list[tuple[Path, _recording.Recording]]:
+    """``o.legs`` heating or cooling: each run cut into its legs of that direction
+    (:func:`thermocal.legs.find_legs` on the first fitted temperature), each leg a run;
+    refused, naming ``legs``, when no file has such a leg."""
+    if o.legs == "all":
+        return loaded
+    from thermocal.legs import find_legs
+
+    out = []
+    for path, rec in loaded:
+        name = run_temp_names(rec, o.temperatures)[0]
+        legs = find_legs(rec.time_s, rec.temperature_c(name))
+        out += [(path, rec.select(slice(g.start, g.stop))) for g in legs.of(o.legs)]
+    if not out:
+        where = ", ".join(str(p) for p, _ in loaded).replace("{", "{{").replace("}", "}}")
+        raise ThermocalInputError.naming(
+            f"no {o.legs} leg in {where} (the temperature "
+            f"never {'rises' if o.legs == 'heating' else 'falls'} beyond its noise); give "
+            "{legs} all or the other direction",
+            "legs",
+        )
+    return out
 
 
 __all__ = [

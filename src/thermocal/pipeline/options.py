@@ -114,6 +114,9 @@ class FitOptions:
         A quantised or slow thermometer (:mod:`thermocal.thermometer`: a lattice of 0.1 °C or
         more, or updated every second or slower) fitted on the temperature reconstructed at
         each sample (default), or on its reading as logged.
+    legs : {"all", "heating", "cooling"}
+        Every sample, or only the heating (cooling) legs of the first temperature column
+        (:func:`thermocal.legs.find_legs`), each leg a run.
 
     Raises
     ------
@@ -164,9 +167,14 @@ class FitOptions:
     heater_band: float = 0.5
     heater_min_hold: float = 60.0
     temperature: Literal["reconstructed", "raw"] = "reconstructed"
+    legs: Literal["all", "heating", "cooling"] = "all"
 
     def __post_init__(self) -> None:
         set_ = object.__setattr__  # frozen: normalise in place once
+        if self.legs not in ("all", "heating", "cooling"):
+            raise ParameterError(
+                "legs", f"{{name}} must be all, heating or cooling, got {self.legs!r}"
+            )
         if self.temperature not in ("reconstructed", "raw"):
             raise ParameterError(
                 "temperature", f"{{name}} must be reconstructed or raw, got {self.temperature!r}"
@@ -261,6 +269,9 @@ class ValidateOptions:
         Test-site latitude [°] of a turntable run judging a triad calibration.
     static_s : float
         A multi-position calibration's held-out session: shortest still pose [s].
+    legs : bool
+        The command's text shows each heating and cooling leg (the result holds them in
+        any case: :attr:`thermocal.validation.ValidationResult.legs_after`).
 
     Raises
     ------
@@ -299,6 +310,7 @@ class ValidateOptions:
     chamber_log: ChamberLogSpec | None = None
     latitude: float | None = None
     static_s: float = 1.0
+    legs: bool = False
 
     def __post_init__(self) -> None:
         set_ = object.__setattr__  # frozen: normalise in place once

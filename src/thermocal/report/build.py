@@ -734,7 +734,8 @@ def _coefficient_rows(
     (``deg/h/degC`` → ``deg/s/degC`` for °/s data: value / k)."""
     mu, k = model_factor(model, unit)
     rows = []
-    for i, c in enumerate(model.get("coefficients") or []):
+    for i, entry in enumerate(model.get("coefficients") or []):
+        c = entry if isinstance(entry, dict) else {}  # the list is informative: shown as is
         val = c.get("value")
         se = c.get("stderr")
         cunit = str(c.get("unit", ""))

@@ -434,7 +434,8 @@ def imu_noise_text(where: str, res: ImuNoise) -> list[Block]:
 def inspection_text(r: Inspection) -> list[Block]:
     """What a recording holds: samples, duration, sample rate, gaps and segments (or why
     they are not computed), a table of each column's role, unit, range, mean, NaN and
-    spikes, a quantised or slow thermometer, and the first ten gaps.
+    spikes, a quantised or slow thermometer, each temperature's heating and cooling legs
+    when it has any (the first ten), and the first ten gaps.
 
     Parameters
     ----------
@@ -467,6 +468,17 @@ def inspection_text(r: Inspection) -> list[Block]:
             out.append(
                 f"temperature {name!r}: the thermometer is {th['kind']}; fit, px4-tempcal "
                 "and ardupilot-tempcal fit on the temperature reconstructed at each sample"
+            )
+    for name, lg in r.legs.items():  # a record without a leg: said in the JSON only
+        if lg is not None and lg["legs"]:
+            shown = ", ".join(
+                f"{g['direction']} {g['start_s']:.6g}…{g['stop_s']:.6g} s "
+                f"({g['temp_start_c']:.4g}→{g['temp_stop_c']:.4g} °C)"
+                for g in lg["legs"][:10]
+            )
+            more = f" … {len(lg['legs']) - 10} more" if len(lg["legs"]) > 10 else ""
+            out.append(
+                f"temperature {name!r}: {lg['summary']}" + (f": {shown}{more}" if shown else "")
             )
     if r.gaps:
         out.append(

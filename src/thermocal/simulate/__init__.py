@@ -50,6 +50,7 @@ from thermocal.simulate.bias import (
     WarmupTerm,
     play_operator,
 )
+from thermocal.simulate.lag import die_temperature, scenario_thermal_lag
 from thermocal.simulate.noise import FLICKER_MAX_RATE_HZ, NoiseParams, flicker_noise, simulate_noise
 from thermocal.simulate.scenarios import (
     DEFAULT_LATITUDE_DEG,
@@ -95,6 +96,8 @@ from thermocal.simulate.thermal import (
     uniform_step,
 )
 
+SCENARIOS["thermal-lag"] = scenario_thermal_lag  # its module imports the scenarios' helpers
+
 __all__ = [
     "ACCEL",
     "DEFAULT_LATITUDE_DEG",
@@ -124,6 +127,7 @@ __all__ = [
     "ThermalResult",
     "WarmupTerm",
     "chamber_air",
+    "die_temperature",
     "flicker_noise",
     "get_preset",
     "play_operator",
@@ -135,6 +139,7 @@ __all__ = [
     "scenario_rlg_modelling",
     "scenario_rlg_validation",
     "scenario_rng",
+    "scenario_thermal_lag",
     "scenario_turntable16",
     "simulate_nodes",
     "simulate_noise",

@@ -126,7 +126,7 @@ def compile_harness(export: CExport, directory: str | Path, compiler: str | None
     main = d / f"{export.prefix}_main.c"
     main.write_text(c_harness(export))
     exe = d / f"{export.prefix}_run"
-    cmd = [cc, *CFLAGS, "-o", str(exe), str(d / export.source_name), str(main)]
+    cmd = [cc, *CFLAGS, "-o", str(exe), str(d / export.source_name), str(main), "-lm"]
     proc = subprocess.run(cmd, capture_output=True, text=True, check=False)
     if proc.returncode != 0:
         raise RuntimeError(f"C compilation failed: {' '.join(cmd)}\n{proc.stderr}")
