@@ -4817,6 +4817,22 @@ MUTANTS: tuple[Mutant, ...] = (
         _t("cli_hysteresis"),
         "fit --legs heating keeps every leg",
     ),
+    Mutant(
+        "family-ladder-offset",
+        P + "stability/family.py",
+        "z = np.ascontiguousarray(base[:: m // j])",
+        "z = np.ascontiguousarray(base[1 :: m // j])",
+        _t("family_memory"),
+        "the noise identification's contiguous decimation starting one point late",
+    ),
+    Mutant(
+        "family-ladder-divides",
+        P + "stability/family.py",
+        "        if m % j:\n            j, base = 1, x\n",
+        "        if m % j and m < 0:\n            j, base = 1, x\n",
+        _t("family_memory"),
+        "a rung that does not divide m decimated further (m = 3 after m = 2)",
+    ),
 )
 
 
