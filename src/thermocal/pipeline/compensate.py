@@ -1324,9 +1324,12 @@ def compensate_triads(
     kind_out = written_format(dst)
     check_not_input(dst, [src])
     _check_chunk_rows(chunk_rows)
-    source = _open_source(src, fmt, r)
+    source = _chamber_columns(_open_source(src, fmt, r), r.chamber_log)
     plans = _triad_plans(triads, source.names, source.available, src, g_sensitivity)
     resolved = _resolve_triads(source, plans, r.time_unit, r.signal_unit)
+    used = [(c, resolved.conversions[c].conversion) for c in _triad_temperatures(plans)]
+    source = _chamber_joined(source, r.chamber_log, units.TIME_UNITS[resolved.time.unit],
+                             _own_temperature(source, used), chunk_rows)  # fmt: skip
     out_info = _triad_output_info(source.info, source.time_col, resolved, plans)
     warn_formula_names(dst, source.names)
     state = _PassState()
@@ -1420,9 +1423,10 @@ def _write_triads(
     temp_names = _triad_temperatures(plans)
     w = writer(tmp, out_info)
     try:
-        for chunk in source.chunks(chunk_rows):
+        for raw_chunk in source.chunks(chunk_rows):
             row0 = state.rows
-            t = _chunk_time(chunk, source.time_col, t_factor, src, row0, state.last_t)
+            t = _chunk_time(raw_chunk, source.time_col, t_factor, src, row0, state.last_t)
+            chunk = source.joined(raw_chunk, t)
             temps: dict[str, FloatArray] = {}
             for c in temp_names:
                 v = numeric_column(chunk, c, src, row0)
