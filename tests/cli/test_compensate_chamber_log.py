@@ -100,3 +100,50 @@ def test_compensate_correlation_needs_the_recordings_temperature(
     assert code == 2
     lines = [x for x in err.splitlines() if x.strip()]
     assert len(lines) == 1 and "--chamber-offset" in lines[0], err
+
+
+def test_a_triad_calibration_takes_the_log_too(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A turntable calibration (triads on T_imu) applied with a chamber log: the chamber
+    column is the log at each sample (written here: the log's °C, read every 10 s, linearly
+    interpolated), the compensated columns those of the run without the log."""
+    import pandas as pd
+
+    from thermocal.turntable.simulate import simulate_turntable_thermal
+    from thermocal.writers import write_recording
+
+    soaks, held = [], None
+    for rec, truth in simulate_turntable_thermal(seed=7):
+        f = tmp_path / f"{truth['label']}.parquet"
+        write_recording(rec, f)
+        if truth["held_out"]:
+            held = rec
+        else:
+            soaks.append(str(f))
+    assert held is not None
+    cal = tmp_path / "cal.json"
+    _ok(capsys, "turntable", *soaks, "--temps", "T_imu", "-o", str(cal))
+    rec_path = tmp_path / "held.csv"
+    t = held.time_s
+    pd.DataFrame({"time": t, **{c: held.column(c) for c in held.columns if c != "time"}}).to_csv(
+        rec_path, index=False
+    )
+    log = tmp_path / "log.csv"
+    lt = np.arange(0.0, float(t[-1] - t[0]) + 20.0, 10.0)
+    lv = 20.0 + 0.001 * lt
+    log.write_text("Time,Air [°C]\n" + "".join(
+        f"{int(s) // 3600:02d}:{int(s) % 3600 // 60:02d}:{int(s) % 60:02d},{v:.3f}\n"
+        for s, v in zip(lt, lv, strict=True)), encoding="utf-8")  # fmt: skip
+    plain, joined = tmp_path / "plain.csv", tmp_path / "joined.csv"
+    _ok(capsys, "compensate", str(cal), str(rec_path), "-o", str(plain), "--time-unit", "s")
+    _ok(capsys, "compensate", str(cal), str(rec_path), "-o", str(joined), "--time-unit", "s",
+        "--chamber-log", str(log), "--chamber-offset", "0", "--chunk-rows", "5000")  # fmt: skip
+    a = pd.read_csv(joined)
+    b = pd.read_csv(plain)
+    expected = np.interp(t - t[0], lt, np.round(lv, 3))
+    np.testing.assert_allclose(a["chamber"].to_numpy(), expected, rtol=0.0, atol=1e-9)
+    comp = [c for c in b.columns if c.endswith("_comp")]
+    assert len(comp) == 3  # the gyro triad
+    for c in comp:
+        np.testing.assert_allclose(a[c].to_numpy(), b[c].to_numpy(), rtol=0.0, atol=1e-12)
