@@ -147,3 +147,16 @@ def test_a_triad_calibration_takes_the_log_too(
     assert len(comp) == 3  # the gyro triad
     for c in comp:
         np.testing.assert_allclose(a[c].to_numpy(), b[c].to_numpy(), rtol=0.0, atol=1e-12)
+
+
+def test_a_model_on_the_chamber_column_without_the_log_says_how(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    log, rec = _files(tmp_path)
+    model = _fit(capsys, tmp_path, log, rec, "chamber")
+    code, _out, err = _run(capsys, "compensate", str(model), str(rec), "-o",
+                           str(tmp_path / "o.csv"), *UNITS)  # fmt: skip
+    lines = [x for x in err.splitlines() if x.strip()]
+    assert code == 2 and len(lines) == 1, err
+    assert "'chamber' are not in the file" in lines[0]
+    assert lines[0].endswith("give the chamber log, --chamber-log FILE[:CHANNEL]")

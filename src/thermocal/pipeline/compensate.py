@@ -459,7 +459,9 @@ def compensate_file(
     read : ReadOptions, optional
         How the file is read (:class:`~thermocal.readers.options.ReadOptions`): time column
         and units, ``temp_conversion`` for raw-count temperatures (over the file's
-        metadata), a log's topic, a text log's layout.
+        metadata), a log's topic, a text log's layout; ``chamber_log``: a chamber's own log
+        joined once for the whole recording (a first pass over its time) and given to each
+        chunk at its times as the column ``chamber`` [°C], kept in ``out``.
     signal : str, optional
         The signal column (default: the model's ``signal_name``).
     chunk_rows : int
@@ -954,10 +956,13 @@ def _channel_plan(
         )
     missing = [c for c in temp_names if c not in names]
     if missing:
-        raise MissingColumnError(
+        chamber = CHAMBER_COLUMN in missing  # the model was fitted on a chamber log's column
+        raise MissingColumnError.naming(
             f"{src}: the model's temperature column(s) "
             f"{', '.join(repr(c) for c in missing)} are not in the file; "
             f"available: {ctx.available}"
+            + ("; give the chamber log, {chamber_log} FILE[:CHANNEL]" if chamber else ""),
+            *(("chamber_log",) if chamber else ()),
         )
     model_col = sig_name + MODEL_SUFFIX
     comp_col = sig_name + COMP_SUFFIX
