@@ -4288,8 +4288,8 @@ MUTANTS: tuple[Mutant, ...] = (
     Mutant(
         "chamber-log-zone-sign",
         P + "readers/chamber_log.py",
-        "return float(rec.time_s[0]) + timezone_seconds(spec.tz) - start_utc",
-        "return float(rec.time_s[0]) - timezone_seconds(spec.tz) - start_utc",
+        "return t0 + timezone_seconds(spec.tz) - start_utc",
+        "return t0 - timezone_seconds(spec.tz) - start_utc",
         _t("chamber_log_join"),
         "the log's zone applied the wrong way",
     ),
@@ -4832,6 +4832,31 @@ MUTANTS: tuple[Mutant, ...] = (
         "        if m % j and m < 0:\n            j, base = 1, x\n",
         _t("family_memory"),
         "a rung that does not divide m decimated further (m = 3 after m = 2)",
+    ),
+    Mutant(
+        "chamber-stream-chunk-start",
+        P + "readers/chamber_log.py",
+        "tau = self.join.clock(t, self.t0)",
+        "tau = self.join.clock(t, float(np.asarray(t)[0]))",
+        _t("compensate_chamber_log"),
+        "compensate --chamber-log maps each chunk's times from the chunk's start, not the "
+        "recording's",
+    ),
+    Mutant(
+        "chamber-stream-last-time",
+        P + "pipeline/compensate.py",
+        "np.array([first, state.last_t])",
+        "np.array([first, first + 1.0])",
+        _t("compensate_chamber_log"),
+        "compensate --chamber-log checks the log's cover on the first second only",
+    ),
+    Mutant(
+        "turntable-validate-g-sensitivity",
+        P + "turntable/thermal.py",
+        "xc = correct(triad, x if g_term is None else x - g_term, temp_c, bias_to_data)",
+        "xc = correct(triad, x, temp_c, bias_to_data)",
+        _t("turntable_gsens"),
+        "validate of a turntable calibration leaves the gyro's A f in the dwell means",
     ),
 )
 

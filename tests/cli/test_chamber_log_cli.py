@@ -118,10 +118,10 @@ def test_profile_correlate_two_chamber_logs(
 
 RECORDING_COMMANDS = (
     "inspect", "fit", "validate", "allan", "metrics", "noise", "report", "ratetable",
-    "turntable", "multipos", "profile join",
+    "turntable", "multipos", "profile join", "compensate",
 )  # fmt: skip
-"""The commands that read a sensor's recording and take its chamber log (compensate, which
-streams its file in chunks, takes the recording ``profile join -o`` writes)."""
+"""The commands that read a sensor's recording and take its chamber log (compensate joins
+it once and then chunk by chunk)."""
 
 
 def test_every_recording_command_takes_the_same_options() -> None:

@@ -32,6 +32,7 @@ from thermocal.cli.common import (
     TimeOpt,
     TimeUnitOpt,
     TopicOpt,
+    chamber_log_options,
     emit,
     handle_errors,
     progress,
@@ -52,6 +53,7 @@ else:
 
 @app.command("compensate")
 @handle_errors
+@chamber_log_options
 def compensate_cmd(
     model_file: ModelArg,
     file: FileArg,

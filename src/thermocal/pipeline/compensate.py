@@ -74,6 +74,12 @@ from thermocal.models.base import TemperatureModel
 from thermocal.models.ranges import outside_range_dict
 from thermocal.models.rundata import check_sensor_id
 from thermocal.outputs import refuse_special_input, sidecar_path, warn_formula_names
+from thermocal.readers.chamber_log import (
+    ChamberStream,
+    chamber_clock_join,
+    chamber_needs_series,
+    read_chamber_log,
+)
 from thermocal.readers.common import default_time_column, names_list
 from thermocal.readers.dispatch import (
     TIME_HINT_PARAMETERS,
@@ -82,7 +88,7 @@ from thermocal.readers.dispatch import (
     time_hint,
 )
 from thermocal.readers.formats import FileFormat, format_of
-from thermocal.readers.options import ReadOptions
+from thermocal.readers.options import CHAMBER_COLUMN, ChamberLogSpec, ReadOptions
 from thermocal.readers.table import load_sidecar, numeric_column
 from thermocal.recording import (
     ABSOLUTE_ZERO_C,
@@ -453,7 +459,9 @@ def compensate_file(
     read : ReadOptions, optional
         How the file is read (:class:`~thermocal.readers.options.ReadOptions`): time column
         and units, ``temp_conversion`` for raw-count temperatures (over the file's
-        metadata), a log's topic, a text log's layout.
+        metadata), a log's topic, a text log's layout; ``chamber_log``: a chamber's own log
+        joined once for the whole recording (a first pass over its time) and given to each
+        chunk at its times as the column ``chamber`` [°C], kept in ``out``.
     signal : str, optional
         The signal column (default: the model's ``signal_name``).
     chunk_rows : int
@@ -598,7 +606,7 @@ def compensate_channels(
     sig_list = [c for c, _m in channels]
     if len(set(sig_list)) != len(sig_list):
         raise ThermocalInputError(f"a signal column appears twice: {sig_list}")
-    source = _open_source(src, fmt, r)
+    source = _chamber_columns(_open_source(src, fmt, r), r.chamber_log)
     sig_opts = units.per_signal_unit(r.signal_unit, sig_list)
     ctx = _FileContext(src, source.names, source.info, source.time_col, source.available,
                        signal_given)  # fmt: skip
@@ -619,6 +627,10 @@ def compensate_channels(
             "time_unit",
         )
     t_unit = plans[0].time_unit
+    used = [(c, p.convs[c]) for p in plans if p.model.temperature_unit == "degC"
+            for c in p.temp_names]  # fmt: skip
+    source = _chamber_joined(source, r.chamber_log, units.TIME_UNITS[t_unit],
+                             _own_temperature(source, used), chunk_rows)  # fmt: skip
     out_info = _output_info(source.info, source.time_col, t_unit, plans)
     warn_formula_names(dst, source.names)  # every output column begins as an input's name
     state = _PassState()
@@ -651,6 +663,8 @@ class _Source:
     table: pd.DataFrame | None
     time_col: str
     available: str
+    chamber: ChamberStream | None = None
+    """A chamber log joined by time: its column appended to every chunk."""
 
     def chunks(self, chunk_rows: int) -> Iterator[pd.DataFrame | pa.RecordBatch]:
         """The file's rows, ``chunk_rows`` at a time."""
@@ -658,6 +672,102 @@ class _Source:
             return _slices(self.table, chunk_rows)
         assert self.fmt.stream is not None
         return self.fmt.stream(self.src, chunk_rows)
+
+    def joined(
+        self, chunk: pd.DataFrame | pa.RecordBatch, t: FloatArray
+    ) -> pd.DataFrame | pa.RecordBatch:
+        """The chunk with the chamber log's column at its times ``t`` [s] (as it is without
+        a log)."""
+        if self.chamber is None:
+            return chunk
+        return _append_columns(chunk, {CHAMBER_COLUMN: self.chamber.values(t)})
+
+
+def _chamber_columns(source: _Source, spec: ChamberLogSpec | None) -> _Source:
+    """The source with the chamber log's column among its names and its unit (°C) among
+    the stated temperatures (the values come with :func:`_chamber_joined`); a file that has
+    a column of that name already is refused."""
+    if spec is None:
+        return source
+    if CHAMBER_COLUMN in source.names:
+        raise ThermocalInputError.naming(
+            f"{source.src}: already has a column {CHAMBER_COLUMN!r}; was the chamber log "
+            "joined already? Drop {chamber_log}, or rename the column",
+            "chamber_log",
+        )
+    info = dict(source.info)
+    info["temperatures"] = {**dict(info.get("temperatures") or {}), CHAMBER_COLUMN: "degC"}
+    names = [*source.names, CHAMBER_COLUMN]
+    return dataclasses.replace(source, names=names, info=info, available=names_list(names))
+
+
+def _chamber_joined(
+    source: _Source,
+    spec: ChamberLogSpec | None,
+    t_factor: float,
+    own: tuple[str, units.TemperatureConversion | None] | None,
+    chunk_rows: int,
+) -> _Source:
+    """The source with the chamber log joined once for the whole recording
+    (:func:`thermocal.readers.chamber_log.chamber_clock_join`) from a first pass over its
+    time: its first and last times with an offset given or from absolute clocks (constant
+    memory), its time and ``own`` temperature [°C] (16 B a row) for the correlation."""
+    if spec is None:
+        return source
+    log = read_chamber_log(spec)
+    src, state = source.src, _PassState()
+    ts: list[FloatArray] = []
+    ys: list[FloatArray] = []
+    first = math.nan
+    series = False
+    for chunk in source.chunks(chunk_rows):
+        row0 = state.rows
+        t = _chunk_time(chunk, source.time_col, t_factor, src, row0, state.last_t)
+        if not t.size:
+            continue
+        if state.rows == 0:
+            first = float(t[0])
+            series = chamber_needs_series(spec, log, first)
+        if series and own is not None:
+            y = numeric_column(chunk, own[0], src, row0)
+            if own[1] is not None:
+                y = own[1].to_celsius(y, f"{src}: column {own[0]!r} (chunk from row {row0})")
+            _check_finite(y, f"temperature column {own[0]!r}", src, row0)
+            ts.append(t)
+            ys.append(y)
+        state.advance(t)
+    state.check_rows(src)
+    assert state.last_t is not None
+    if series and own is None:
+        raise ThermocalInputError.naming(
+            f"{src}: the clocks are joined by correlating the recording's own temperature "
+            "with the chamber log's, and the recording has none stated in °C: give "
+            "{chamber_offset} (or {chamber_tz} with absolute clocks)",
+            "chamber_offset",
+            "chamber_tz",
+        )
+    t_all = np.concatenate(ts) if series else np.array([first, state.last_t])
+    y_all = np.concatenate(ys) if series else None
+    log, join = chamber_clock_join(
+        spec, t_all, y_all, own[0] if own else None, log=log, stacklevel=5
+    )
+    return dataclasses.replace(source, chamber=ChamberStream(log, join, first))
+
+
+def _own_temperature(
+    source: _Source, used: Sequence[tuple[str, units.TemperatureConversion | None]]
+) -> tuple[str, units.TemperatureConversion | None] | None:
+    """The recording's own temperature to correlate with a chamber log: the first of the
+    models' temperature columns in °C or converted to it (``used``: column, conversion),
+    else the first the file states in °C; None without one."""
+    for name, conv in used:
+        if name != CHAMBER_COLUMN:
+            return name, conv
+    for name, unit in dict(source.info.get("temperatures") or {}).items():
+        stated = name != CHAMBER_COLUMN and name in source.names and bool(unit)
+        if stated and units.normalize_temperature_unit(str(unit)) == "degC":
+            return str(name), None
+    return None
 
 
 def _head(src: Path, fmt: FileFormat) -> tuple[list[str], dict[str, Any]]:
@@ -740,10 +850,11 @@ class _ChannelPass:
         pool = ThreadPoolExecutor(max_workers=1, thread_name_prefix="thermocal-write")
         pending: Future[None] | None = None
         try:
-            for chunk in self.source.chunks(self.chunk_rows):
+            for raw_chunk in self.source.chunks(self.chunk_rows):
                 row0 = state.rows
-                t = _chunk_time(chunk, self.source.time_col, self.t_factor, src, row0,
+                t = _chunk_time(raw_chunk, self.source.time_col, self.t_factor, src, row0,
                                 state.last_t)  # fmt: skip
+                chunk = self.source.joined(raw_chunk, t)
                 table = _compensate_one_chunk(chunk, t, self.plans, self.groups, src, row0)
                 if pending is not None:
                     pending.result()
@@ -845,10 +956,13 @@ def _channel_plan(
         )
     missing = [c for c in temp_names if c not in names]
     if missing:
-        raise MissingColumnError(
+        chamber = CHAMBER_COLUMN in missing  # the model was fitted on a chamber log's column
+        raise MissingColumnError.naming(
             f"{src}: the model's temperature column(s) "
             f"{', '.join(repr(c) for c in missing)} are not in the file; "
             f"available: {ctx.available}"
+            + ("; give the chamber log, {chamber_log} FILE[:CHANNEL]" if chamber else ""),
+            *(("chamber_log",) if chamber else ()),
         )
     model_col = sig_name + MODEL_SUFFIX
     comp_col = sig_name + COMP_SUFFIX
@@ -1215,9 +1329,12 @@ def compensate_triads(
     kind_out = written_format(dst)
     check_not_input(dst, [src])
     _check_chunk_rows(chunk_rows)
-    source = _open_source(src, fmt, r)
+    source = _chamber_columns(_open_source(src, fmt, r), r.chamber_log)
     plans = _triad_plans(triads, source.names, source.available, src, g_sensitivity)
     resolved = _resolve_triads(source, plans, r.time_unit, r.signal_unit)
+    used = [(c, resolved.conversions[c].conversion) for c in _triad_temperatures(plans)]
+    source = _chamber_joined(source, r.chamber_log, units.TIME_UNITS[resolved.time.unit],
+                             _own_temperature(source, used), chunk_rows)  # fmt: skip
     out_info = _triad_output_info(source.info, source.time_col, resolved, plans)
     warn_formula_names(dst, source.names)
     state = _PassState()
@@ -1311,9 +1428,10 @@ def _write_triads(
     temp_names = _triad_temperatures(plans)
     w = writer(tmp, out_info)
     try:
-        for chunk in source.chunks(chunk_rows):
+        for raw_chunk in source.chunks(chunk_rows):
             row0 = state.rows
-            t = _chunk_time(chunk, source.time_col, t_factor, src, row0, state.last_t)
+            t = _chunk_time(raw_chunk, source.time_col, t_factor, src, row0, state.last_t)
+            chunk = source.joined(raw_chunk, t)
             temps: dict[str, FloatArray] = {}
             for c in temp_names:
                 v = numeric_column(chunk, c, src, row0)

@@ -20,10 +20,18 @@ import re
 import warnings
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 import numpy as np
+import numpy.typing as npt
 
-from thermocal.chamber_join import join_clock, joined_values, timezone_seconds, timezone_text
+from thermocal.chamber_join import (
+    ClockJoin,
+    join_clock,
+    joined_values,
+    timezone_seconds,
+    timezone_text,
+)
 from thermocal.errors import (
     FileFormatError,
     PlausibilityWarning,
@@ -474,15 +482,82 @@ def read_chamber_log(spec: ChamberLogSpec) -> ChamberLog:
     return parse_chamber_log(_text_of(p.read_bytes(), str(p)), spec, str(p))
 
 
+def chamber_needs_series(spec: ChamberLogSpec, log: ChamberLog, t0: float) -> bool:
+    """Whether the join needs the recording's whole time and temperature (the clocks found
+    by correlation) rather than its first and last times (an offset given or from absolute
+    clocks).
+
+    Parameters
+    ----------
+    spec : ChamberLogSpec
+        The log and what is stated of it.
+    log : ChamberLog
+        The log read.
+    t0 : float
+        The recording's first time [s].
+
+    Returns
+    -------
+    bool
+
+    Raises
+    ------
+    ThermocalInputError
+        An absolute recording and a dated log without ``--chamber-tz``.
+    """
+    return spec.offset_s is None and _absolute_offset(t0, log, spec) is None
+
+
+@dataclass(frozen=True)
+class ChamberStream:
+    """A chamber log joined once to a recording read in chunks: each chunk's chamber
+    temperature :math:`L(\\tau(t))`, :math:`\\tau = o + (1 + \\delta)(t - t_0)`, interpolated
+    linearly onto its own times (:func:`thermocal.chamber_join.joined_values` chunk by chunk).
+
+    Attributes
+    ----------
+    log : ChamberLog
+        The log.
+    join : ClockJoin
+        The clocks' mapping.
+    t0 : float
+        The recording's first time [s].
+    """
+
+    log: ChamberLog
+    join: ClockJoin
+    t0: float
+
+    def values(self, t: npt.ArrayLike) -> FloatArray:
+        """The log's temperature [°C] at recording times ``t`` [s].
+
+        Parameters
+        ----------
+        t : array_like
+            Recording times [s] (a chunk's).
+
+        Returns
+        -------
+        numpy.ndarray
+            Temperature [°C] at each time.
+        """
+        tau = self.join.clock(t, self.t0)
+        return np.interp(tau, self.log.time_s, self.log.temp_c)
+
+    def record(self) -> dict[str, Any]:
+        """:func:`chamber_join_record` of the join."""
+        return chamber_join_record(self.log, self.join)
+
+
 ABSOLUTE_AFTER_S = 946_684_800.0
 """A recording whose first time [s] is after this (2000-01-01 00:00 UTC) holds absolute
 times (seconds since 1970 in UTC); before it, time relative to its start."""
 
 
-def _absolute_offset(rec: Recording, log: ChamberLog, spec: ChamberLogSpec) -> float | None:
-    """The offset [s] from absolute clocks: a recording in UTC and a dated log, its zone
-    given (refused without it); None when either clock is relative."""
-    if log.start is None or float(rec.time_s[0]) < ABSOLUTE_AFTER_S:
+def _absolute_offset(t0: float, log: ChamberLog, spec: ChamberLogSpec) -> float | None:
+    """The offset [s] from absolute clocks: a recording (first time ``t0`` [s]) in UTC and a
+    dated log, its zone given (refused without it); None when either clock is relative."""
+    if log.start is None or t0 < ABSOLUTE_AFTER_S:
         return None
     if spec.tz is None:
         raise ThermocalInputError.naming(
@@ -493,7 +568,93 @@ def _absolute_offset(rec: Recording, log: ChamberLog, spec: ChamberLogSpec) -> f
             "chamber_offset",
         )
     start_utc = log.start.replace(tzinfo=dt.UTC).timestamp()
-    return float(rec.time_s[0]) + timezone_seconds(spec.tz) - start_utc
+    return t0 + timezone_seconds(spec.tz) - start_utc
+
+
+def chamber_join_record(log: ChamberLog, join: ClockJoin) -> dict[str, Any]:
+    """What a recording's metadata keeps of its chamber join (``meta.extra["chamber_log"]``).
+
+    Parameters
+    ----------
+    log : ChamberLog
+        The log joined.
+    join : ClockJoin
+        The clocks' mapping.
+
+    Returns
+    -------
+    dict
+        The log, channel, unit, its source, whether it is a set-point, and
+        :meth:`~thermocal.chamber_join.ClockJoin.to_dict`.
+    """
+    return {
+        "log": log.source, "channel": log.channel, "unit": log.unit,
+        "unit_source": log.unit_source, "setpoint": log.setpoint, **join.to_dict(),
+    }  # fmt: skip
+
+
+def chamber_clock_join(
+    spec: ChamberLogSpec,
+    time_s: npt.ArrayLike,
+    own_temp_c: npt.ArrayLike | None,
+    own: str | None,
+    *,
+    log: ChamberLog | None = None,
+    stacklevel: int = 3,
+) -> tuple[ChamberLog, ClockJoin]:
+    """Read a chamber log and map a recording's clock onto it
+    (:func:`thermocal.chamber_join.join_clock`: offset given, from absolute clocks, or by
+    correlation with the recording's own temperature, stated in a warning).
+
+    Parameters
+    ----------
+    spec : ChamberLogSpec
+        The log and what is stated of it.
+    time_s : array_like
+        The recording's times [s] (the whole recording; with a given or absolute offset its
+        first and last times suffice).
+    own_temp_c : array_like, optional
+        The recording's own temperature [°C] at ``time_s`` (correlation only).
+    own : str, optional
+        That temperature's column name, for the statement.
+    log : ChamberLog, optional
+        The log already read (default: read from ``spec``).
+    stacklevel : int
+        Of the correlation's warning.
+
+    Returns
+    -------
+    (ChamberLog, ClockJoin)
+
+    Raises
+    ------
+    ThermocalInputError
+        The log unreadable, not covering the recording, or the clocks not joinable.
+    """
+    log = read_chamber_log(spec) if log is None else log
+    t = np.asarray(time_s, dtype=np.float64)
+    absolute = _absolute_offset(float(t[0]), log, spec) if spec.offset_s is None else None
+    try:
+        join = join_clock(
+            t, log.time_s, log.temp_c, rec_temp_c=own_temp_c,
+            offset_s=spec.offset_s, drift_ppm=spec.drift_ppm, absolute_offset_s=absolute,
+            timezone=None if spec.tz is None else timezone_text(timezone_seconds(spec.tz)),
+        )  # fmt: skip
+    except ThermocalInputError as exc:
+        raise ThermocalInputError.around(exc, f"{log.source}: ") from None
+    if join.method == "correlation":
+        warnings.warn(
+            TimestampWarning.naming(
+                f"{log.source}: clocks joined by correlating {log.channel!r} with the "
+                f"recording's {own!r}: offset {join.offset_s:.6g} ± {join.offset_sigma_s:.2g} s, "
+                f"drift {join.drift_ppm:.4g} ± {join.drift_sigma_ppm:.2g} ppm (r = "
+                f"{join.correlation:.4f}); the offset includes the sensor's thermal lag; give "
+                "{chamber_offset} when the clocks are known",
+                "chamber_offset",
+            ),
+            stacklevel=stacklevel,
+        )
+    return log, join
 
 
 def join_chamber_log(
@@ -528,37 +689,14 @@ def join_chamber_log(
     """
     import dataclasses
 
-    log = read_chamber_log(spec)
     own = next((c for c in rec.temperatures if c != CHAMBER_COLUMN), None)
-    absolute = _absolute_offset(rec, log, spec) if spec.offset_s is None else None
-    try:
-        join = join_clock(
-            rec.time_s, log.time_s, log.temp_c,
-            rec_temp_c=rec.temperature_c(own) if own is not None else None,
-            offset_s=spec.offset_s, drift_ppm=spec.drift_ppm, absolute_offset_s=absolute,
-            timezone=None if spec.tz is None else timezone_text(timezone_seconds(spec.tz)),
-        )  # fmt: skip
-    except ThermocalInputError as exc:
-        raise ThermocalInputError.around(exc, f"{log.source}: ") from None
-    if join.method == "correlation":
-        warnings.warn(
-            TimestampWarning.naming(
-                f"{log.source}: clocks joined by correlating {log.channel!r} with the "
-                f"recording's {own!r}: offset {join.offset_s:.6g} ± {join.offset_sigma_s:.2g} s, "
-                f"drift {join.drift_ppm:.4g} ± {join.drift_sigma_ppm:.2g} ppm (r = "
-                f"{join.correlation:.4f}); the offset includes the sensor's thermal lag; give "
-                "{chamber_offset} when the clocks are known",
-                "chamber_offset",
-            ),
-            stacklevel=3,
-        )
+    log, join = chamber_clock_join(
+        spec, rec.time_s, rec.temperature_c(own) if own is not None else None, own, stacklevel=4
+    )
     values = joined_values(join, rec.time_s, log.time_s, log.temp_c)
     out = rec.with_columns({CHAMBER_COLUMN: values}, {CHAMBER_COLUMN: "degC"})
     extra = dict(rec.meta.extra)
-    extra["chamber_log"] = {
-        "log": log.source, "channel": log.channel, "unit": log.unit,
-        "unit_source": log.unit_source, "setpoint": log.setpoint, **join.to_dict(),
-    }  # fmt: skip
+    extra["chamber_log"] = chamber_join_record(log, join)
     temps = rec.temperatures if temperatures is None else temperatures
     return dataclasses.replace(
         out,
@@ -572,6 +710,10 @@ __all__ = [
     "ABSOLUTE_AFTER_S",
     "CHAMBER_UNITS",
     "ChamberLog",
+    "ChamberStream",
+    "chamber_clock_join",
+    "chamber_join_record",
+    "chamber_needs_series",
     "join_chamber_log",
     "parse_chamber_log",
     "read_chamber_log",

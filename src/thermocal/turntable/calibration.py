@@ -1086,7 +1086,10 @@ def validate_turntable_run(
 ) -> list[Any]:
     """A turntable calibration of triads judged on an independent 16-position run.
 
-    The reference of every sample comes from the encoder angles (the true body rate
+    A gyro triad holding a g-sensitivity :math:`A` has :math:`A f` taken off its samples
+    before they are compensated (:math:`f` the specific force the encoders' gravity
+    direction gives, as ``compensate`` takes it off with the accelerometer's). The
+    reference of every sample comes from the encoder angles (the true body rate
     ``ω_ib^b = C_nᵇ ω_ie^n + ω_nb^b(α, β, α̇, β̇)`` over each interval,
     :func:`.kinematics.omega_ib_b`; the specific force ``C_nᵇ (0, 0, g)`` at rest); per triad
     the dwell-mean and move-angle errors before and after compensation
@@ -1146,23 +1149,13 @@ def validate_turntable_run(
     for tri in triads:
         unit = tri.unit
         x = np.column_stack([rec.column(c) for c in tri.columns])
-        temp = rec.temperature_c(tri.temperature)
-        if tri.model.kind == "gyro":
-            ref = units.convert(omega, "rad/s", unit)
-            factor = float(units.convert(np.array([1.0]), unit, "deg/h")[0])
-            bias_to_data = float(units.convert(np.array([1.0]), "deg/h", unit)[0])
-            fig_unit = "deg/h"
-        else:
-            ref = units.convert(f_true, "m/s^2", unit)
-            factor = float(units.convert(np.array([1.0]), unit, "mg")[0])
-            bias_to_data = float(units.convert(np.array([1.0]), "mg", unit)[0])
-            fig_unit = "mg"
+        ref, factor, bias_to_data, fig_unit = _triad_reference(tri, omega, f_true)
         out.append(
             thermal.validate_triad(
                 tri.model,
                 unit,
                 x,
-                temp,
+                rec.temperature_c(tri.temperature),
                 np.asarray(ref),
                 list(seg.dwells),
                 bias_to_data,
@@ -1170,6 +1163,34 @@ def validate_turntable_run(
                 name=tri.name,
                 figure_unit_factor=factor,
                 figure_unit=fig_unit,
+                g_term=_g_sensitivity_term(tri, f_true),
             )
         )
     return out
+
+
+def _g_sensitivity_term(tri: Any, f_true: npt.NDArray[np.float64]) -> Any:
+    """A gyro triad's g-sensitivity term :math:`A f` in its unit
+    (:meth:`~thermocal.models.calibration.Triad.g_sensitivity_term`, ``f_true`` the specific
+    force [m/s²] the encoders' gravity direction gives: the gyro model
+    :math:`\\omega_{raw} = (I + E)\\omega + b + A f`, IEEE Std 952-1997 annex B); None for
+    an accelerometer triad or a gyro without one."""
+    if tri.model.kind != "gyro" or tri.g_sensitivity is None:
+        return None
+    return tri.g_sensitivity_term(f_true, "m/s^2", tri.unit)
+
+
+def _triad_reference(
+    tri: Any, omega: npt.NDArray[np.float64], f_true: npt.NDArray[np.float64]
+) -> tuple[Any, float, float, str]:
+    """The triad's reference in its unit (body rate for a gyro, specific force for an
+    accelerometer), its unit → figure unit factor, figure unit → its unit, and the figure
+    unit (°/h or mg)."""
+    unit = tri.unit
+    if tri.model.kind == "gyro":
+        ref = units.convert(omega, "rad/s", unit)
+        factor = float(units.convert(np.array([1.0]), unit, "deg/h")[0])
+        return ref, factor, float(units.convert(np.array([1.0]), "deg/h", unit)[0]), "deg/h"
+    ref = units.convert(f_true, "m/s^2", unit)
+    factor = float(units.convert(np.array([1.0]), unit, "mg")[0])
+    return ref, factor, float(units.convert(np.array([1.0]), "mg", unit)[0]), "mg"

@@ -972,6 +972,7 @@ def validate_triad(
     name: str,
     figure_unit_factor: float,
     figure_unit: str,
+    g_term: FloatArray | None = None,
 ) -> TriadValidation:
     """Compare raw and compensated samples ``x`` (n, 3, data unit) with ``reference`` (n, 3,
     same unit; the true body rate or specific force from the encoder angles) over the
@@ -1001,6 +1002,9 @@ def validate_triad(
         Factor from the data's unit to ``figure_unit``.
     figure_unit : str
         Unit of the dwell figures (°/h or mg).
+    g_term : numpy.ndarray, shape (n, 3), optional
+        A gyro's g-sensitivity term :math:`A f` [data unit], taken off before the
+        compensation (the compensated samples :math:`C(x - A f)`; the raw ones as read).
 
     Returns
     -------
@@ -1016,7 +1020,7 @@ def validate_triad(
     - *A method for separating the combined error coefficients of a ring-laser gyro triad
       based on dual-axis rotation*, Chinese invention patent CN104880182.
     """
-    xc = correct(triad, x, temp_c, bias_to_data)
+    xc = correct(triad, x if g_term is None else x - g_term, temp_c, bias_to_data)
 
     def dwell_rms(v: FloatArray) -> tuple[float, float, float]:
         errs = np.array(
