@@ -503,7 +503,7 @@ def chamber_needs_series(spec: ChamberLogSpec, log: ChamberLog, t0: float) -> bo
     Raises
     ------
     ThermocalInputError
-        An absolute recording and a dated log without ``--chamber-tz``.
+        An absolute recording and a dated log without its time zone (``chamber_tz``).
     """
     return spec.offset_s is None and _absolute_offset(t0, log, spec) is None
 
