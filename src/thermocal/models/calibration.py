@@ -266,6 +266,58 @@ class Triad:
         out: FloatArray = (f * to_g) @ a.T
         return out
 
+    def correct(self, x: Any, temp_c: Any, to_data: float, unit: str) -> FloatArray:
+        """The compensated samples: ``(I + E(T))⁻¹ (x − b(T))``
+        (:func:`thermocal.turntable.thermal.correct`), or for an accelerometer triad with
+        ``k2`` the ``a`` of ``x = (I + E(T)) a + b(T) + K2 ⊙ (a/g)²`` by Newton's method
+        (:func:`thermocal.multipos.accel_k2.invert_k2`), in blocks; the one formula of
+        ``compensate`` and ``validate`` (``A f`` of a gyro's g-sensitivity taken off ``x``
+        before).
+
+        Parameters
+        ----------
+        x : array_like, shape (n, 3)
+            Samples [``unit``].
+        temp_c : array_like, shape (n,)
+            Their temperatures [°C].
+        to_data : float
+            The factor from the model's bias unit (°/h or mg) to ``unit``.
+        unit : str
+            The samples' unit (of the triad's kind).
+
+        Returns
+        -------
+        numpy.ndarray, shape (n, 3)
+            Compensated samples [``unit``].
+
+        Notes
+        -----
+        .. math:: x = (I + E(T))\\, a + b(T) + K_2 \\odot (a / g)^2
+
+        References
+        ----------
+        - IEEE Std 1293-1998, *IEEE Standard Specification Format Guide and Test Procedure
+          for Linear, Single-Axis, Nongyroscopic Accelerometers* (the K2 term).
+        """
+        from thermocal.turntable import thermal
+
+        if self.k2 is None:
+            return thermal.correct(self.model, x, temp_c, to_data)
+        from thermocal import units
+        from thermocal.multipos.accel_k2 import invert_k2
+
+        xs = np.asarray(x, dtype=np.float64)
+        tc = np.broadcast_to(np.asarray(temp_c, dtype=np.float64), xs.shape[:1])
+        to_out = float(units.convert(np.array([1.0]), self.unit, unit)[0])
+        g = float(units.convert(np.array([1.0]), "g", unit)[0])
+        k2 = np.asarray(self.k2, dtype=np.float64) * to_out
+        out = np.empty_like(xs)
+        for a0 in range(0, xs.shape[0], thermal.CORRECT_BLOCK):
+            sl = slice(a0, min(xs.shape[0], a0 + thermal.CORRECT_BLOCK))
+            b, e = thermal.error_terms(self.model, tc[sl])
+            out[sl] = invert_k2(xs[sl] - b * to_data, e + np.eye(3), k2, g)
+        return out
+
     def calibrated_unit(self) -> str:
         """The unit of the columns the triad was calibrated on: raw counts for a triad with
         a count scale, else its unit (the unit of a column that states none).

@@ -1379,7 +1379,8 @@ class _TriadPlan:
         thermal: Any,
         force: FloatArray | None = None,
     ) -> FloatArray:
-        """The chunk's compensated samples (n, 3) (:func:`thermocal.turntable.thermal.correct`),
+        """The chunk's compensated samples (n, 3) (:meth:`Triad.correct
+        <thermocal.models.calibration.Triad.correct>`: K2 inverted where the triad holds it),
         ``A f`` taken off first when ``force`` (the accelerometer triad's compensated output,
         in its unit) is given."""
         x = np.empty((temp.size, 3))
@@ -1395,26 +1396,7 @@ class _TriadPlan:
         self.n_outside += int(np.count_nonzero((temp < m.t_lo_c) | (temp > m.t_hi_c)))
         if force is not None and self.force_from is not None:  # A f off (Triad.g_sensitivity)
             x = x - self.tri.g_sensitivity_term(force, self.force_from.out_unit, self.out_unit)
-        if getattr(self.tri, "k2", None) is not None:
-            return self._correct_k2(x, temp, thermal)
-        out: FloatArray = thermal.correct(m, x, temp, self.to_data)
-        return out
-
-    def _correct_k2(self, x: FloatArray, temp: FloatArray, thermal: Any) -> FloatArray:
-        """An accelerometer triad with K2: ``x = (I + E(T)) a + b(T) + K2 ⊙ (a/g)²``
-        inverted per sample (:func:`thermocal.multipos.accel_k2.invert_k2`), in blocks of
-        ``thermal.CORRECT_BLOCK`` samples, in the data's unit."""
-        from thermocal.multipos.accel_k2 import invert_k2
-
-        to_out = float(units.convert(np.array([1.0]), self.tri.unit, self.out_unit)[0])
-        g = float(units.convert(np.array([1.0]), "g", self.out_unit)[0])
-        k2 = np.asarray(self.tri.k2, dtype=np.float64) * to_out
-        out = np.empty_like(x)
-        for a0 in range(0, x.shape[0], thermal.CORRECT_BLOCK):
-            sl = slice(a0, min(x.shape[0], a0 + thermal.CORRECT_BLOCK))
-            b, e = thermal.error_terms(self.tri.model, temp[sl])
-            e = e + np.eye(3)
-            out[sl] = invert_k2(x[sl] - b * self.to_data, e, k2, g)
+        out: FloatArray = self.tri.correct(x, temp, self.to_data, self.out_unit)
         return out
 
 
