@@ -924,7 +924,11 @@ def _summary(
         sigma = np.array([f.sigma[0] for f in m.fits])
         if kind == "accel":
             d = _triad_dict(theta, sigma, to_a, a_unit)
-            d["method"] = runs[0].result.accel.method
+            d["method"] = _accel_fit(runs[0]).method
+            k2 = _stored_k2(runs, a_unit)
+            if k2:  # stored in the calibration (module Triad.k2), per standard g²
+                d["k2"] = {"k2": k2["k2"].tolist(), "k2_sigma": k2["k2_sigma"].tolist(),
+                           "unit": f"{a_unit}/g^2"}  # fmt: skip
         else:
             d = _triad_dict(theta, sigma, to_g, str(g_unit))
             d["method"] = run_dicts[0]["gyro"]["method"]
