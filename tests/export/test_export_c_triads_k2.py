@@ -17,6 +17,9 @@ import pytest
 from gsens_session import run
 from k2_session import COLS, add_k2, calibrate, held_out, simulate
 from thermocal.export.c.harness import find_compiler
+from thermocal.models.calibration import Calibration, Triad
+from thermocal.pipeline.model_file import save_calibration
+from thermocal.turntable.thermal import constant_triad
 
 MAIN = r"""
 #include <stdio.h>
@@ -69,6 +72,24 @@ def test_c_equals_compensate(made: dict[str, Any]) -> None:
     # the term matters here: K2 (f/g)² is far beyond the tolerance
     k2 = np.array(__import__("json").loads((d / "cal.json").read_text())["triads"][0]["k2"])
     assert np.max(np.abs(k2 * (py / 9.80665) ** 2)) > 1e-2
+
+
+@pytest.mark.skipif(find_compiler() is None, reason="no C compiler on this machine")
+def test_c_equals_python_at_the_largest_k2(tmp_path: Path) -> None:
+    """|K2| = 0.01 g/g² and forces up to 4 g (the Newton steps' stated range): the C equals
+    :meth:`Triad.correct` to 1e-10 relative (one algorithm in doubles), where a Newton step
+    with half the derivative stays 1e-6 off."""
+    theta = np.array([36.0, -18.0, 7.2, 100.0, -50.0, 20.0, 1.0, 2.0, 3.0, 4.0, 5.0, 6.0])
+    model = constant_triad("accel", 25.0, theta, np.eye(12), method="multipos")
+    tri = Triad("accel", ("ax", "ay", "az"), "g", "", model, k2=np.array([0.01, -0.01, 0.007]))
+    save_calibration(Calibration([], [tri]), tmp_path / "cal.json")
+    rng = np.random.default_rng(7)
+    x = rng.normal(size=(2000, 3))
+    x *= rng.uniform(0.0, 4.0, (2000, 1)) / np.linalg.norm(x, axis=1)[:, None]
+    pd.DataFrame(x, columns=COLS).to_csv(tmp_path / "x.csv", index=False)
+    c_out = _c_output(tmp_path, tmp_path / "cal.json", tmp_path / "x.csv")
+    want = tri.correct(x, np.full(len(x), 25.0), 1e-3, "g")  # bias mg → g
+    np.testing.assert_allclose(c_out, want, rtol=1e-10, atol=1e-13)
 
 
 def test_export_params_warns_that_the_firmware_holds_no_k2(made: dict[str, Any]) -> None:

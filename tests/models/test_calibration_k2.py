@@ -92,3 +92,23 @@ def test_a_doubtful_one_is_refused(change: Any, words: tuple[str, ...]) -> None:
         calibration_from_dict(_resummed(d), "c.json")
     for w in words:
         assert w in str(err.value), (w, str(err.value))
+
+
+def test_correct_inverts_k2_in_the_samples_unit() -> None:
+    """A triad in mg with K2 in mg/g², samples in m/s²: ``Triad.correct`` returns the ``a``
+    of ``x = (I + E) a + b + K2 ⊙ (a/g)²`` written here in m/s² (g = 9.80665 m/s²)."""
+    theta = np.array([36.0, -18.0, 7.2, 100.0, -50.0, 20.0, 1.0, 2.0, 3.0, 4.0, 5.0, 6.0])
+    model = constant_triad("accel", 25.0, theta, np.eye(12), method="multipos")
+    k2_mg = np.array([5.0, -4.0, 3.0])  # mg/g²
+    tri = Triad("accel", ("ax", "ay", "az"), "mg", "", model, k2=k2_mg)
+    ms2 = 9.80665e-3  # m/s² per mg
+    arc = np.pi / 648000.0
+    e = np.diag(theta[3:6] * 1e-6)
+    # misalignments yx, zx, xy, zy, xz, yz at E[0,1], E[0,2], E[1,0], E[1,2], E[2,0], E[2,1]
+    for (i, j), v in zip([(0, 1), (0, 2), (1, 0), (1, 2), (2, 0), (2, 1)], theta[6:], strict=True):
+        e[i, j] = v * arc
+    rng = np.random.default_rng(5)
+    a = rng.normal(0.0, 9.80665, (200, 3))
+    x = a @ (np.eye(3) + e).T + theta[0:3] * ms2 + k2_mg * ms2 * (a / 9.80665) ** 2
+    got = tri.correct(x, np.full(200, 25.0), ms2, "m/s^2")
+    np.testing.assert_allclose(got, a, rtol=0, atol=1e-12)
