@@ -90,13 +90,20 @@ def _session_with_k2(tmp: Path, k2_m_s2: np.ndarray) -> tuple[Path, dict]:
 
 def test_k2_through_the_command_line(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     k2 = np.array([0.05, -0.04, 0.03])  # m/s² per g²
-    p, _ = _session_with_k2(tmp_path, k2)
+    p, truth = _session_with_k2(tmp_path, k2)
     capsys.readouterr()
     args = ["multipos", str(p), "-o", str(tmp_path / "cal.json"), "--accel",
             "accel_x,accel_y,accel_z", "--accel-k2"]  # fmt: skip
     assert main([*args, "--json"]) == 0
-    run = json.loads(capsys.readouterr().out)["runs"][0]
+    doc = json.loads(capsys.readouterr().out)
+    run = doc["runs"][0]
     got = run["accel_k2"]
+    # stored per standard g² (the session's per local g² times (g_n/g_L)²)
+    g_l = truth["gravity_m_s2"]
+    stored = doc["accel"]["k2"]
+    assert stored["unit"] == "m/s^2/g^2" and doc["accel"]["method"] == "gravity-magnitude with K2"
+    np.testing.assert_allclose(stored["k2"], np.array(got["k2"]) * (9.80665 / g_l) ** 2,
+                               rtol=1e-12)  # fmt: skip
     assert got["unit"] == "m/s^2/g^2" and all(got["significant"])
     for v, e, t in zip(got["k2"], got["k2_sigma"], k2, strict=True):
         assert abs(v - t) < 3 * e

@@ -300,6 +300,18 @@ def _g_sensitivity_notes(triad: Triad) -> list[str]:
     ]
 
 
+def _k2_notes(triad: Triad) -> list[str]:
+    """An accelerometer triad's K2, which no firmware parameter holds (also warned)."""
+    if getattr(triad, "k2", None) is None:
+        return []
+    worst = float(np.max(np.abs(np.asarray(triad.k2, dtype=np.float64))))
+    return [
+        f"{triad.name}: K2 (up to {worst:.4g} {triad.k2_unit}) is not held (the firmware has "
+        "no second-order term): the offsets and scales are those fitted with K2, and each "
+        f"axis reads up to {worst:.4g} {triad.unit} more at 1 g along it"
+    ]
+
+
 def _triads_of(
     cal: Calibration, gyro: Sequence[str] | None, accel: Sequence[str] | None
 ) -> dict[str, Triad]:
@@ -400,7 +412,7 @@ def triad_params(
             params[n], types[n] = v, 9
         for n, v in zip(scales or [], t.scale, strict=False):
             params[n], types[n] = v, 9
-        lost = _lost_notes(t) + _g_sensitivity_notes(triads[kind])
+        lost = _lost_notes(t) + _g_sensitivity_notes(triads[kind]) + _k2_notes(triads[kind])
         for line in lost:
             warnings.warn(line, ThermocalWarning, stacklevel=2)
         notes += lost

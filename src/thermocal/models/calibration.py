@@ -5,7 +5,7 @@ channel (any family), with the channel's signal column, its unit as given and an
 role, in one versioned file::
 
     {
-      "format": "thermocal-calibration", "format_version": 1 | 2 | 3,
+      "format": "thermocal-calibration", "format_version": 1 | 2 | 3 | 4,
       "created_utc": "...", "thermocal_version": "...",
       "channels": [
         {"name": "gx", "signal": "gx", "unit": "deg/s",
@@ -20,7 +20,10 @@ role, in one versioned file::
          "count_scale": {"value": K, "unit": "deg/s"},          (raw counts; version ≥ 2)
          "g_sensitivity": [[A_xx, A_xy, A_xz], …],  (gyro only, version 3: row the gyro
          "g_sensitivity_sigma": [[…], …],             axis, column the specific force's
-         "g_sensitivity_unit": "deg/s/g"},            axis; the triad's unit per g)
+         "g_sensitivity_unit": "deg/s/g",             axis; the triad's unit per g)
+         "k2": [K2_x, K2_y, K2_z],          (accel only, version 4: each axis's
+         "k2_sigma": […],                     second-order coefficient, the triad's
+         "k2_unit": "m/s^2/g^2"},             unit per g², g = 9.80665 m/s²)
         …
       ],
       "checksum": "<sha256 of the canonical JSON without this key>"
@@ -50,14 +53,16 @@ from thermocal.models.schema import verify_model_dict
 from thermocal.recording import FloatArray
 
 CALIBRATION_FORMAT = "thermocal-calibration"
-CALIBRATION_FORMAT_VERSION = 3
+CALIBRATION_FORMAT_VERSION = 4
 """The newest version this thermocal reads.  Version 2 added a triad's ``count_scale``,
-version 3 a gyro triad's ``g_sensitivity``; a file is written with the lowest version
-that holds what it carries (1 without either), so a file without them is what it was, and
-an older thermocal refuses a file whose counts it could not convert, or whose
-g-sensitivity it would silently leave out, rather than apply it wrongly."""
+version 3 a gyro triad's ``g_sensitivity``, version 4 an accelerometer triad's ``k2``; a
+file is written with the lowest version that holds what it carries (1 without any), so a
+file without them is what it was, and an older thermocal refuses a file whose counts it
+could not convert, or whose g-sensitivity or K2 it would silently leave out, rather than
+apply it wrongly."""
 COUNT_SCALE_FORMAT_VERSION = 2
 G_SENSITIVITY_FORMAT_VERSION = 3
+K2_FORMAT_VERSION = 4
 
 ROLE_KINDS = ("gyro", "accel")
 """Roles a channel may declare."""
@@ -156,13 +161,17 @@ class Triad:
         Latitude of the calibration runs [°].
     g_sensitivity, g_sensitivity_sigma : numpy.ndarray, shape (3, 3), or None
         A gyro triad's sensitivity to specific force ``A`` and its σ [``unit`` per g].
+    k2, k2_sigma : numpy.ndarray, shape (3,), or None
+        An accelerometer triad's second-order coefficients and their σ [``unit`` per g²].
 
     Notes
     -----
     .. math:: x_c = (I + E(T))^{-1} (x - b(T) - A f)
 
     with ``A f`` only for a gyro triad with a ``g_sensitivity`` (``f`` the accelerometer
-    triad's compensated output in g).
+    triad's compensated output in g).  An accelerometer triad with ``k2`` is inverted from
+    ``x = (I + E(T)) x_c + b(T) + K_2 ⊙ (x_c / g)^2`` (:func:`thermocal.multipos.
+    accel_k2.invert_k2`).
 
     References
     ----------
@@ -199,6 +208,19 @@ class Triad:
     before format version 3 have no such key)."""
     g_sensitivity_sigma: FloatArray | None = field(default=None, compare=False)
     """The standard uncertainties of ``g_sensitivity`` (3×3) [``unit`` per g]."""
+    k2: FloatArray | None = field(default=None, compare=False)
+    """An accelerometer triad's second-order coefficient per axis, ``K2`` [``unit`` per g²,
+    g = 9.80665 m/s²] (IEEE Std 1293-1998's ``K2 a²``, one per axis): the axis reads
+    ``K2_i (a_i/g)²`` more under the true specific force ``a``.  Compensation inverts
+    ``x = (I + E(T)) a + b(T) + K2 ⊙ (a/g)²`` per sample; None: not applied (files before
+    format version 4 have no such key)."""
+    k2_sigma: FloatArray | None = field(default=None, compare=False)
+    """The standard uncertainties of ``k2`` (3,) [``unit`` per g²]."""
+
+    @property
+    def k2_unit(self) -> str:
+        """The unit of ``k2`` as the file states it: the triad's unit per g² (``mg/g^2``)."""
+        return f"{self.unit}/g^2"
 
     @property
     def g_sensitivity_unit(self) -> str:
@@ -242,6 +264,58 @@ class Triad:
         to_unit = float(units.convert(np.array([1.0]), self.unit, unit)[0])
         a = np.asarray(self.g_sensitivity, dtype=np.float64) * to_unit
         out: FloatArray = (f * to_g) @ a.T
+        return out
+
+    def correct(self, x: Any, temp_c: Any, to_data: float, unit: str) -> FloatArray:
+        """The compensated samples: ``(I + E(T))⁻¹ (x − b(T))``
+        (:func:`thermocal.turntable.thermal.correct`), or for an accelerometer triad with
+        ``k2`` the ``a`` of ``x = (I + E(T)) a + b(T) + K2 ⊙ (a/g)²`` by Newton's method
+        (:func:`thermocal.multipos.accel_k2.invert_k2`), in blocks; the one formula of
+        ``compensate`` and ``validate`` (``A f`` of a gyro's g-sensitivity taken off ``x``
+        before).
+
+        Parameters
+        ----------
+        x : array_like, shape (n, 3)
+            Samples [``unit``].
+        temp_c : array_like, shape (n,)
+            Their temperatures [°C].
+        to_data : float
+            The factor from the model's bias unit (°/h or mg) to ``unit``.
+        unit : str
+            The samples' unit (of the triad's kind).
+
+        Returns
+        -------
+        numpy.ndarray, shape (n, 3)
+            Compensated samples [``unit``].
+
+        Notes
+        -----
+        .. math:: x = (I + E(T))\\, a + b(T) + K_2 \\odot (a / g)^2
+
+        References
+        ----------
+        - IEEE Std 1293-1998, *IEEE Standard Specification Format Guide and Test Procedure
+          for Linear, Single-Axis, Nongyroscopic Accelerometers* (the K2 term).
+        """
+        from thermocal.turntable import thermal
+
+        if self.k2 is None:
+            return thermal.correct(self.model, x, temp_c, to_data)
+        from thermocal import units
+        from thermocal.multipos.accel_k2 import invert_k2
+
+        xs = np.asarray(x, dtype=np.float64)
+        tc = np.broadcast_to(np.asarray(temp_c, dtype=np.float64), xs.shape[:1])
+        to_out = float(units.convert(np.array([1.0]), self.unit, unit)[0])
+        g = float(units.convert(np.array([1.0]), "g", unit)[0])
+        k2 = np.asarray(self.k2, dtype=np.float64) * to_out
+        out = np.empty_like(xs)
+        for a0 in range(0, xs.shape[0], thermal.CORRECT_BLOCK):
+            sl = slice(a0, min(xs.shape[0], a0 + thermal.CORRECT_BLOCK))
+            b, e = thermal.error_terms(self.model, tc[sl])
+            out[sl] = invert_k2(xs[sl] - b * to_data, e + np.eye(3), k2, g)
         return out
 
     def calibrated_unit(self) -> str:
@@ -464,6 +538,7 @@ class Calibration:
                         else {}
                     ),
                     **_g_sensitivity_dict(t),
+                    **_k2_dict(t),
                 }
                 for t in self.triads
             ]
@@ -473,6 +548,8 @@ class Calibration:
 
 def _format_version(triads: list[Triad]) -> int:
     """The lowest format version that holds what the triads carry."""
+    if any(t.k2 is not None for t in triads):
+        return K2_FORMAT_VERSION
     if any(t.g_sensitivity is not None for t in triads):
         return G_SENSITIVITY_FORMAT_VERSION
     if any(t.count_scale is not None for t in triads):
@@ -491,6 +568,18 @@ def _g_sensitivity_dict(t: Triad) -> dict[str, Any]:
             None if sigma is None else np.asarray(sigma, dtype=np.float64).tolist()
         ),
         "g_sensitivity_unit": t.g_sensitivity_unit,
+    }
+
+
+def _k2_dict(t: Triad) -> dict[str, Any]:
+    """An accelerometer triad's K2 keys in the file (none without one)."""
+    if t.k2 is None:
+        return {}
+    sigma = t.k2_sigma
+    return {
+        "k2": np.asarray(t.k2, dtype=np.float64).tolist(),
+        "k2_sigma": None if sigma is None else np.asarray(sigma, dtype=np.float64).tolist(),
+        "k2_unit": t.k2_unit,
     }
 
 
@@ -580,6 +669,12 @@ def calibration_from_dict(d: dict[str, Any], where: str) -> Calibration:
             f"{where}: triad {sensed!r} has a g_sensitivity, which needs format_version "
             f"{G_SENSITIVITY_FORMAT_VERSION}; the file says {ver}"
         )
+    squared = next((t.name for t in triads if t.k2 is not None), None)
+    if squared is not None and ver < K2_FORMAT_VERSION:
+        raise ModelFileError(
+            f"{where}: triad {squared!r} has a k2, which needs format_version "
+            f"{K2_FORMAT_VERSION}; the file says {ver}"
+        )
     try:
         return Calibration(channels, triads)
     except ThermocalInputError as exc:
@@ -626,6 +721,7 @@ def _triad_from_dict(t: Any, at: str) -> Triad:
         ),
         _count_scale_from_dict(t.get("count_scale"), t["unit"], at),
         *_g_sensitivity_from_dict(t, model.kind, at),
+        *_k2_from_dict(t, model.kind, at),
     )
 
 
@@ -674,6 +770,41 @@ def _g_sensitivity_from_dict(
     return a, sigma
 
 
+def _k2_from_dict(
+    t: dict[str, Any], kind: str, at: str
+) -> tuple[FloatArray | None, FloatArray | None]:
+    """An accelerometer triad's ``k2`` and its σ (format version 4): three finite numbers
+    in the triad's unit per g² as ``k2_unit`` states; (None, None) when absent."""
+    if t.get("k2") is None:
+        for key in ("k2_sigma", "k2_unit"):
+            if t.get(key) is not None:
+                raise ModelFileError(f"{at}: {key} without k2")
+        return None, None
+    if kind != "accel":
+        raise ModelFileError(f"{at}: a k2 belongs to an accelerometer triad, not a {kind}")
+    want = f"{t['unit']}/g^2"
+    if t.get("k2_unit") != want:
+        raise ModelFileError(
+            f"{at}.k2_unit: expected {want!r} (the triad's unit per g²), got {t.get('k2_unit')!r}"
+        )
+    out: list[FloatArray | None] = []
+    for key, nonneg in (("k2", False), ("k2_sigma", True)):
+        v = t.get(key)
+        if v is None and key == "k2_sigma":
+            out.append(None)
+            continue
+        ok = isinstance(v, list) and len(v) == 3 and all(
+            not isinstance(x, bool) and isinstance(x, int | float) and math.isfinite(x)
+            and not (nonneg and x < 0)
+            for x in v
+        )  # fmt: skip
+        if not ok:
+            sign = "non-negative " if nonneg else ""
+            raise ModelFileError(f"{at}.{key}: expected three finite {sign}numbers (x, y, z)")
+        out.append(np.array(v, dtype=np.float64))
+    return out[0], out[1]
+
+
 def _count_scale_from_dict(cs: Any, unit: str, at: str) -> float | None:
     """A triad's ``count_scale`` object ``{"value": K, "unit": U}`` (format version 2): K a
     positive finite number, U the triad's own unit; None when absent."""
@@ -699,6 +830,7 @@ __all__ = [
     "CALIBRATION_FORMAT",
     "CALIBRATION_FORMAT_VERSION",
     "G_SENSITIVITY_FORMAT_VERSION",
+    "K2_FORMAT_VERSION",
     "Calibration",
     "Channel",
     "calibration_from_dict",

@@ -135,8 +135,6 @@ def validate_held_out_session(
     - Tedaldi, D., Pretto, A., Menegatti, E., "A robust and easy to implement method for IMU
       calibration without external equipments", Proc. IEEE ICRA 2014, pp. 3042-3049.
     """
-    from thermocal.turntable import thermal
-
     by = {t.model.kind: t for t in triads}
     acc, g_m_s2 = _accel_and_gravity(by, triads, rec, latitude_deg, static_s)
     t = rec.time_s
@@ -146,7 +144,7 @@ def validate_held_out_session(
     xa, a_in = triad_columns(rec, acc, unit_opts)
     a_unit = a_in.unit
     ta = temp_of(acc)
-    xa_c = thermal.correct(acc.model, xa, ta, a_in.to_data)
+    xa_c = acc.correct(xa, ta, a_in.to_data, a_unit)  # K2 inverted when it holds one
     gyr = by.get("gyro")
     xg = xg_c = None
     if gyr is not None:
@@ -155,7 +153,7 @@ def validate_held_out_session(
         tg = temp_of(gyr)
         # its g-sensitivity taken off with the accelerometer's output, as compensate does
         af = gyr.g_sensitivity_term(xa_c, a_unit, g_unit)
-        xg_c = thermal.correct(gyr.model, xg - af, tg, g_in.to_data)
+        xg_c = gyr.correct(xg - af, tg, g_in.to_data, g_unit)
         xg = units.convert(xg, g_unit, "rad/s")
         xg_c = units.convert(xg_c, g_unit, "rad/s")
     sections = detect_poses(t, xa, xg, static_s=static_s)

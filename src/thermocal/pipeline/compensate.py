@@ -1497,7 +1497,8 @@ class _TriadPlan:
         thermal: Any,
         force: FloatArray | None = None,
     ) -> FloatArray:
-        """The chunk's compensated samples (n, 3) (:func:`thermocal.turntable.thermal.correct`),
+        """The chunk's compensated samples (n, 3) (:meth:`Triad.correct
+        <thermocal.models.calibration.Triad.correct>`: K2 inverted where the triad holds it),
         ``A f`` taken off first when ``force`` (the accelerometer triad's compensated output,
         in its unit) is given."""
         x = np.empty((temp.size, 3))
@@ -1513,7 +1514,7 @@ class _TriadPlan:
         self.n_outside += int(np.count_nonzero((temp < m.t_lo_c) | (temp > m.t_hi_c)))
         if force is not None and self.force_from is not None:  # A f off (Triad.g_sensitivity)
             x = x - self.tri.g_sensitivity_term(force, self.force_from.out_unit, self.out_unit)
-        out: FloatArray = thermal.correct(m, x, temp, self.to_data)
+        out: FloatArray = self.tri.correct(x, temp, self.to_data, self.out_unit)
         return out
 
 

@@ -713,7 +713,7 @@ def _fit_triads(
     for kind, cols, unit in (("accel", opts.accel, a_unit), ("gyro", opts.gyro, g_unit)):
         if cols is None or unit is None:
             continue
-        fits = [r.result.accel if kind == "accel" else r.result.gyro for r in runs]
+        fits = [_accel_fit(r) if kind == "accel" else r.result.gyro for r in runs]
         if len(runs) > 1:
             m = thermal.fit_triad(
                 kind, [float(r.result.temperature_c) for r in runs],  # type: ignore[arg-type]
@@ -742,9 +742,32 @@ def _fit_triads(
                            for r in runs),
                 g_sensitivity=None if stored is None else stored.matrix,
                 g_sensitivity_sigma=None if stored is None else stored.sigma,
+                **(_stored_k2(runs, unit) if kind == "accel" else {}),
             )
         )  # fmt: skip
     return triads, models
+
+
+def _accel_fit(run: SessionRun) -> Any:
+    """The accelerometer's linear parameters the triad stores: those fitted with K2 when
+    the session was (``accel_k2``: the stored model is the one K2 belongs to), else the
+    nine of the gravity-magnitude fit."""
+    return run.result.accel if run.accel_k2 is None else run.accel_k2.linear
+
+
+def _stored_k2(runs: list[SessionRun], unit: str) -> dict[str, Any]:
+    """``k2`` and ``k2_sigma`` of the accelerometer Triad [``unit`` per g², g = 9.80665
+    m/s²]: the sessions' K2 (fitted per local gravity g_L, so ``K2 (g/g_L)²``) pooled by
+    inverse variance, ``K̄ = Σ K_r/σ_r² / Σ 1/σ_r²``, ``σ(K̄) = (Σ 1/σ_r²)^(-1/2)``; empty
+    when no session was fitted with K2."""
+    fits = [r.accel_k2 for r in runs if r.accel_k2 is not None]
+    if not fits:
+        return {}
+    to_u = float(units.convert(np.array([1.0]), "mg", unit)[0])
+    ks = np.array([f.k2_mg_per_g2 * (units.G_TO_MG / f.g_mg) ** 2 for f in fits]) * to_u
+    ss = np.array([f.k2_sigma * (units.G_TO_MG / f.g_mg) ** 2 for f in fits]) * to_u
+    w = 1.0 / ss**2
+    return {"k2": (ks * w).sum(axis=0) / w.sum(axis=0), "k2_sigma": 1.0 / np.sqrt(w.sum(axis=0))}
 
 
 def calibrate_files(
@@ -901,7 +924,11 @@ def _summary(
         sigma = np.array([f.sigma[0] for f in m.fits])
         if kind == "accel":
             d = _triad_dict(theta, sigma, to_a, a_unit)
-            d["method"] = runs[0].result.accel.method
+            d["method"] = _accel_fit(runs[0]).method
+            k2 = _stored_k2(runs, a_unit)
+            if k2:  # stored in the calibration (module Triad.k2), per standard g²
+                d["k2"] = {"k2": k2["k2"].tolist(), "k2_sigma": k2["k2_sigma"].tolist(),
+                           "unit": f"{a_unit}/g^2"}  # fmt: skip
         else:
             d = _triad_dict(theta, sigma, to_g, str(g_unit))
             d["method"] = run_dicts[0]["gyro"]["method"]

@@ -210,7 +210,9 @@ def _k2_line(run: dict[str, Any]) -> str:
     )  # fmt: skip
     return (
         f"{run['input']}: accelerometer K2 {terms} {k['unit'].replace('^2', '²')}; "
-        f"gravity-magnitude residual rms with K2 {fmt(k['residual_rms_after'], 3)}"
+        f"gravity-magnitude residual rms with K2 {fmt(k['residual_rms_after'], 3)}; "
+        "stored in the calibration with the bias, scale factors and misalignments fitted "
+        "with it (compensate applies it)"
     )
 
 

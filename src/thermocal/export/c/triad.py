@@ -17,6 +17,11 @@ the calibration holds no accelerometer triad), and computes ``out = (I + E(T))�
 A f)`` with ``f`` converted to g, as :func:`thermocal.pipeline.compensate.compensate_triads`:
 call the accelerometer's function first.
 
+An accelerometer triad with second-order coefficients ``K2`` (``Triad.k2``) inverts
+``x = (I + E(T)) a + b(T) + K2 ⊙ (a/g)²`` for ``a`` by the Newton steps of
+:func:`thermocal.multipos.accel_k2.invert_k2` (as many, from the same linear start), in a
+helper ``<p>_<triad>_solve3``; the signature is unchanged.
+
 A triad calibrated on raw counts (``accel_scale``/``gyro_scale`` of the multi-position
 calibration) takes ``x`` in its physical unit all the same; the header defines the count scale
 ``<P>_<TRIAD>_COUNT_SCALE`` (one count in that unit) and states the conversion
@@ -76,6 +81,69 @@ def _gsens_term(p: str, i: int) -> str:
     )
 
 
+def _k2_consts(p: str, tri: Any) -> list[str]:
+    """An accelerometer triad's K2 in C (in its unit per g²) and one g in its unit; nothing
+    without one."""
+    if getattr(tri, "k2", None) is None:
+        return []
+    g = float(units.convert([1.0], "g", tri.unit)[0])
+    return [
+        f"/* K2 [{c_comment(tri.unit)} per g^2] of x, y, z; one g (9.80665 m/s^2) in "
+        f"{c_comment(tri.unit)} */",
+        f"static const double {p}_K2[3] = {{{', '.join(_lit(v) for v in tri.k2)}}};",
+        f"static const double {p}_G = {_lit(g)};",
+    ]
+
+
+def _solve3_code(name: str) -> list[str]:
+    """A static ``out = m⁻¹ r`` (3×3, adjugate over the determinant) for the K2 inversion."""
+    return [
+        f"static void {name}_solve3(const double m[3][3], const double r[3], double out[3])",
+        "{",
+        "    double det = m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1])",
+        "        - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0])",
+        "        + m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]);",
+        "    out[0] = ((m[1][1] * m[2][2] - m[1][2] * m[2][1]) * r[0]",
+        "        - (m[0][1] * m[2][2] - m[0][2] * m[2][1]) * r[1]",
+        "        + (m[0][1] * m[1][2] - m[0][2] * m[1][1]) * r[2]) / det;",
+        "    out[1] = (-(m[1][0] * m[2][2] - m[1][2] * m[2][0]) * r[0]",
+        "        + (m[0][0] * m[2][2] - m[0][2] * m[2][0]) * r[1]",
+        "        - (m[0][0] * m[1][2] - m[0][2] * m[1][0]) * r[2]) / det;",
+        "    out[2] = ((m[1][0] * m[2][1] - m[1][1] * m[2][0]) * r[0]",
+        "        - (m[0][0] * m[2][1] - m[0][1] * m[2][0]) * r[1]",
+        "        + (m[0][0] * m[1][1] - m[0][1] * m[1][0]) * r[2]) / det;",
+        "}",
+        "",
+    ]
+
+
+def _k2_solve(name: str, p: str, real: str) -> list[str]:
+    """The tail of a K2 triad's function: ``a`` from ``m a + K2 ⊙ (a/g)² = r`` by Newton
+    (:func:`thermocal.multipos.accel_k2.invert_k2`), written to ``out``."""
+    from thermocal.multipos.accel_k2 import NEWTON_STEPS
+
+    return [
+        f"    {name}_solve3((const double (*)[3])m, r, a);",
+        f"    for (k = 0; k < {NEWTON_STEPS}; ++k) {{",
+        "        double jac[3][3], res[3], d[3];",
+        "        for (j = 0; j < 3; ++j) {",
+        f"            double u = a[j] / {p}_G;",
+        "            int i;",
+        f"            res[j] = m[j][0] * a[0] + m[j][1] * a[1] + m[j][2] * a[2] + {p}_K2[j] * u * u"
+        " - r[j];",
+        "            for (i = 0; i < 3; ++i) jac[j][i] = m[j][i];",
+        f"            jac[j][j] += 2.0 * {p}_K2[j] * u / {p}_G;",
+        "        }",
+        f"        {name}_solve3((const double (*)[3])jac, res, d);",
+        "        for (j = 0; j < 3; ++j) a[j] -= d[j];",
+        "    }",
+        f"    out[0] = ({real})a[0];",
+        f"    out[1] = ({real})a[1];",
+        f"    out[2] = ({real})a[2];",
+        "}",
+    ]
+
+
 def _triad_code(
     p: str, tri: Any, bias_to_data: float, real: str, ident: str, force_unit: str | None = None
 ) -> tuple[str, str]:
@@ -89,6 +157,7 @@ def _triad_code(
     P = name.upper()
     order = max(len(f.coef) for f in m.fits)
     consts, f_arg, f_about = _force(P, tri, force_unit, real)
+    k2 = _k2_consts(P, tri)
     gs = [_gsens_term(P, i) if f_arg else "" for i in range(3)]
     rows = []
     for f in m.fits:
@@ -111,12 +180,14 @@ def _triad_code(
         f"/* bias unit ({bias_unit}) to the data's unit ({c_comment(tri.unit)}) */",
         f"static const double {P}_BIAS_TO_DATA = {_lit(bias_to_data)};",
         *consts,
+        *k2,
         "",
+        *(_solve3_code(name) if k2 else []),
         f"void {name}_correct(double temp_c, const {real} x[3]{f_arg}, {real} out[3])",
         "{",
         f"    double t = temp_c < {P}_T_LO ? {P}_T_LO : (temp_c > {P}_T_HI ? {P}_T_HI : temp_c);",
         f"    double dt = t - {P}_TREF;",
-        "    double th[12], m[3][3], r[3], det;",
+        "    double th[12], m[3][3], r[3]" + (", a[3];" if k2 else ", det;"),
         "    int k, j;",
         "    for (k = 0; k < 12; ++k) {",
         f"        double acc = {P}_COEF[k][{order - 1}];",
@@ -135,6 +206,48 @@ def _triad_code(
         f"    r[0] = (double)x[0] - th[0] * {P}_BIAS_TO_DATA{gs[0]};",
         f"    r[1] = (double)x[1] - th[1] * {P}_BIAS_TO_DATA{gs[1]};",
         f"    r[2] = (double)x[2] - th[2] * {P}_BIAS_TO_DATA{gs[2]};",
+    ]
+    if k2:
+        lines += _k2_solve(name, P, real)
+    else:
+        lines += _linear_solve(real)
+    formula = (
+        "out = the a of x = (I + E(T)) a + b(T) + K2 (a/g)^2 (Newton steps)"
+        if k2
+        else f"out = (I + E(T))^-1 (x - b(T){' - A f' if f_arg else ''})"
+    )
+    about = c_comment(
+        f"{tri.name}: {formula} in {tri.unit}{f_about}; columns "
+        f"{', '.join(map(str, tri.columns))}; {_temperature_about(tri)}"
+    )
+    decl = f"/* {about} */\n"
+    if tri.count_scale is not None:
+        unit = c_comment(tri.unit)
+        decl += (
+            f"/* calibrated on raw counts: one count = {P}_COUNT_SCALE {unit}; convert the raw\n"
+            f" * registers first, x[i] = {P}_COUNT_SCALE * counts[i] [{unit}] */\n"
+            f"#define {P}_COUNT_SCALE {_lit(tri.count_scale)}\n"
+        )
+    decl += f"void {name}_correct(double temp_c, const {real} x[3]{f_arg}, {real} out[3]);"
+    return decl, "\n".join(lines)
+
+
+def _temperature_about(tri: Any) -> str:
+    """The comment's words on the temperature the triad's function takes."""
+    m = tri.model
+    if tri.temperature:
+        return f"T [degC] of {tri.temperature}, clamped to [{m.t_lo_c:g}, {m.t_hi_c:g}]"
+    if m.order == 0:
+        return (
+            "no temperature column (none measured): the parameters apply unchanged at "
+            "every temperature, temp_c has no effect"
+        )
+    return f"T [degC] (no column named), clamped to [{m.t_lo_c:g}, {m.t_hi_c:g}]"
+
+
+def _linear_solve(real: str) -> list[str]:
+    """The tail of a linear triad's function: ``out = m⁻¹ r`` inline."""
+    return [
         "    det = m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1])",
         "        - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0])",
         "        + m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]);",
@@ -149,29 +262,6 @@ def _triad_code(
         "        + (m[0][0] * m[1][1] - m[0][1] * m[1][0]) * r[2]) / det);",
         "}",
     ]
-    about = c_comment(
-        f"{tri.name}: out = (I + E(T))^-1 (x - b(T){' - A f' if f_arg else ''}) in "
-        f"{tri.unit}{f_about}; columns "
-        f"{', '.join(map(str, tri.columns))}; "
-        + (
-            f"T [degC] of {tri.temperature}, clamped to [{m.t_lo_c:g}, {m.t_hi_c:g}]"
-            if tri.temperature
-            else "no temperature column (none measured): the parameters apply unchanged at "
-            "every temperature, temp_c has no effect"
-            if m.order == 0
-            else f"T [degC] (no column named), clamped to [{m.t_lo_c:g}, {m.t_hi_c:g}]"
-        )
-    )
-    decl = f"/* {about} */\n"
-    if tri.count_scale is not None:
-        unit = c_comment(tri.unit)
-        decl += (
-            f"/* calibrated on raw counts: one count = {P}_COUNT_SCALE {unit}; convert the raw\n"
-            f" * registers first, x[i] = {P}_COUNT_SCALE * counts[i] [{unit}] */\n"
-            f"#define {P}_COUNT_SCALE {_lit(tri.count_scale)}\n"
-        )
-    decl += f"void {name}_correct(double temp_c, const {real} x[3]{f_arg}, {real} out[3]);"
-    return decl, "\n".join(lines)
 
 
 def generate_c_triads(triads: Sequence[Any], *, prefix: str, real: str = "double") -> CExport:
