@@ -65,3 +65,28 @@ def test_rate_terms_with_jittered_timestamps_match_python(tmp_path: Path) -> Non
     scale = float(np.max(np.abs(py.model_value)))
     assert float(np.max(np.abs(y_c - py.model_value))) <= 1e-9 * scale
     assert float(np.std(py.model_value)) > 0.1  # the rate term is really at work
+
+
+@pytest.mark.parametrize(
+    ("family", "params"),
+    [("poly", {"order": 1}), ("piecewise", {"breakpoints": [25.0]}), ("hyst", {"order": 1})],
+)
+def test_a_state_of_another_layout_is_refused(
+    tmp_path: Path, family: str, params: dict[str, object]
+) -> None:
+    """Each family's generator reads only its own state layout (``thermocal-<family>-1``):
+    a state of another layout (a newer format, another family's) is a ModelFileError naming
+    both, not C built from fields read wrongly."""
+    from thermocal.errors import ModelFileError
+
+    T = np.linspace(10.0, 40.0, 3000)
+    run = RunData(np.arange(3000.0), T[:, None], 0.1 * T, ("T1",), "r")
+    m = make_model(family, **params).fit([run])
+    m.signal_name = "gyro"
+    save_model(m, tmp_path / "m.json")
+    d = load_model_dict(tmp_path / "m.json")
+    generate_c(d, prefix="ok")  # its own layout: accepted
+    d["state"]["layout"] = f"thermocal-{family}-2"
+    want = f"{family} state layout 'thermocal-{family}-2' is not thermocal-{family}-1"
+    with pytest.raises(ModelFileError, match=want):
+        generate_c(d, prefix="bad")

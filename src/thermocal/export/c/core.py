@@ -230,6 +230,31 @@ class ExportContext:
         """The C real type name."""
         return f"{self.prefix}_real"
 
+    def state(self, family: str) -> dict[str, Any]:
+        """The model's ``state``, checked to be in the layout ``thermocal-<family>-1`` that
+        the family's generator reads.
+
+        Parameters
+        ----------
+        family : str
+            The family's name (``"poly"``, ``"piecewise"``, ``"hyst"``).
+
+        Returns
+        -------
+        dict
+            The state as saved.
+
+        Raises
+        ------
+        ModelFileError
+            Another layout (a file of a newer or another family's format).
+        """
+        st: dict[str, Any] = self.model["state"]
+        want = f"thermocal-{family}-1"
+        if st.get("layout") != want:
+            raise ModelFileError(f"{family} state layout {st.get('layout')!r} is not {want}")
+        return st
+
     def lit(self, x: float) -> str:
         """A C literal of the real type (17 significant digits, ``f`` suffix for float).
 

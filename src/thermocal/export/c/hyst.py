@@ -30,9 +30,7 @@ def generate(ctx: ExportContext) -> FamilyCode:
         The family's state fields, constant data and the C bodies of init and update.
     """
     d = ctx.model
-    st = d["state"]
-    if st.get("layout") != "thermocal-hyst-1":
-        raise ModelFileError(f"hyst state layout {st.get('layout')!r} is not thermocal-hyst-1")
+    st = ctx.state("hyst")
     P, r, p = ctx.P, ctx.r, ctx.prefix
     coef = np.asarray(st["coefficients"], dtype=np.float64).ravel()
     tau = float(st["tau_s"])

@@ -33,11 +33,7 @@ def generate(ctx: ExportContext) -> FamilyCode:
         The family's state fields, constant data and the C bodies of init and update.
     """
     d = ctx.model
-    st = d["state"]
-    if st.get("layout") != "thermocal-piecewise-1":
-        raise ModelFileError(
-            f"piecewise state layout {st.get('layout')!r} is not thermocal-piecewise-1"
-        )
+    st = ctx.state("piecewise")
     P, r, p = ctx.P, ctx.r, ctx.prefix
     bps = np.asarray(st["breakpoints"], dtype=np.float64).ravel()
     icp = np.asarray(st["intercepts"], dtype=np.float64).ravel()

@@ -50,9 +50,7 @@ class _PolyPlan:
 def _plan(ctx: ExportContext) -> _PolyPlan:
     """The model's poly state checked (layout, causal rate form) and read."""
     d = ctx.model
-    st = d["state"]
-    if st.get("layout") != "thermocal-poly-1":
-        raise ModelFileError(f"poly state layout {st.get('layout')!r} is not thermocal-poly-1")
+    st = ctx.state("poly")
     terms = st["terms"]
     uses_rate = bool(st.get("uses_rate"))
     rate = st.get("rate") or {}
