@@ -39,7 +39,7 @@ from __future__ import annotations
 
 import datetime as _dt
 import math
-from collections.abc import Collection
+from collections.abc import Callable, Collection
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -746,28 +746,58 @@ def _matrix3(v: Any, at: str, what: str, nonnegative: bool) -> FloatArray:
     return np.array(v, dtype=np.float64)
 
 
+def _vector3(v: Any, at: str, what: str, nonnegative: bool) -> FloatArray:
+    """Three finite numbers (non-negative ones for a σ) as an array."""
+    ok = isinstance(v, list) and len(v) == 3 and all(
+        not isinstance(x, bool) and isinstance(x, int | float) and math.isfinite(x)
+        and not (nonnegative and x < 0)
+        for x in v
+    )  # fmt: skip
+    if not ok:
+        sign = "non-negative " if nonnegative else ""
+        raise ModelFileError(f"{at}.{what}: expected three finite {sign}numbers (x, y, z)")
+    return np.array(v, dtype=np.float64)
+
+
+def _term_from_dict(
+    t: dict[str, Any],
+    kind: str,
+    at: str,
+    key: str,
+    owner: tuple[str, str],
+    per: tuple[str, str],
+    read: Callable[[Any, str, str, bool], FloatArray],
+) -> tuple[FloatArray | None, FloatArray | None]:
+    """A triad's optional term ``key`` and its σ (``key_sigma``): only on the triad kind
+    ``owner[0]`` (named ``owner[1]`` in the message), in the triad's unit per ``per[0]``
+    as ``key_unit`` states (``per[1]`` in the message), its values checked by ``read``;
+    (None, None) when absent."""
+    if t.get(key) is None:
+        for k in (f"{key}_sigma", f"{key}_unit"):
+            if t.get(k) is not None:
+                raise ModelFileError(f"{at}: {k} without {key}")
+        return None, None
+    if kind != owner[0]:
+        raise ModelFileError(f"{at}: a {key} belongs to {owner[1]}, not a {kind}")
+    want = f"{t['unit']}/{per[0]}"
+    if t.get(f"{key}_unit") != want:
+        raise ModelFileError(
+            f"{at}.{key}_unit: expected {want!r} (the triad's unit per {per[1]}), "
+            f"got {t.get(f'{key}_unit')!r}"
+        )
+    value = read(t[key], at, key, False)
+    raw_sigma = t.get(f"{key}_sigma")
+    return value, None if raw_sigma is None else read(raw_sigma, at, f"{key}_sigma", True)
+
+
 def _g_sensitivity_from_dict(
     t: dict[str, Any], kind: str, at: str
 ) -> tuple[FloatArray | None, FloatArray | None]:
     """A triad's ``g_sensitivity`` and its σ (format version 3): only on a gyro triad, 3×3,
     in the triad's unit per g as ``g_sensitivity_unit`` states; (None, None) when absent."""
-    if t.get("g_sensitivity") is None:
-        for key in ("g_sensitivity_sigma", "g_sensitivity_unit"):
-            if t.get(key) is not None:
-                raise ModelFileError(f"{at}: {key} without g_sensitivity")
-        return None, None
-    if kind != "gyro":
-        raise ModelFileError(f"{at}: a g_sensitivity belongs to a gyro triad, not a {kind}")
-    want = f"{t['unit']}/g"
-    if t.get("g_sensitivity_unit") != want:
-        raise ModelFileError(
-            f"{at}.g_sensitivity_unit: expected {want!r} (the triad's unit per g), "
-            f"got {t.get('g_sensitivity_unit')!r}"
-        )
-    a = _matrix3(t["g_sensitivity"], at, "g_sensitivity", False)
-    raw_sigma = t.get("g_sensitivity_sigma")
-    sigma = None if raw_sigma is None else _matrix3(raw_sigma, at, "g_sensitivity_sigma", True)
-    return a, sigma
+    return _term_from_dict(
+        t, kind, at, "g_sensitivity", ("gyro", "a gyro triad"), ("g", "g"), _matrix3
+    )
 
 
 def _k2_from_dict(
@@ -775,34 +805,9 @@ def _k2_from_dict(
 ) -> tuple[FloatArray | None, FloatArray | None]:
     """An accelerometer triad's ``k2`` and its σ (format version 4): three finite numbers
     in the triad's unit per g² as ``k2_unit`` states; (None, None) when absent."""
-    if t.get("k2") is None:
-        for key in ("k2_sigma", "k2_unit"):
-            if t.get(key) is not None:
-                raise ModelFileError(f"{at}: {key} without k2")
-        return None, None
-    if kind != "accel":
-        raise ModelFileError(f"{at}: a k2 belongs to an accelerometer triad, not a {kind}")
-    want = f"{t['unit']}/g^2"
-    if t.get("k2_unit") != want:
-        raise ModelFileError(
-            f"{at}.k2_unit: expected {want!r} (the triad's unit per g²), got {t.get('k2_unit')!r}"
-        )
-    out: list[FloatArray | None] = []
-    for key, nonneg in (("k2", False), ("k2_sigma", True)):
-        v = t.get(key)
-        if v is None and key == "k2_sigma":
-            out.append(None)
-            continue
-        ok = isinstance(v, list) and len(v) == 3 and all(
-            not isinstance(x, bool) and isinstance(x, int | float) and math.isfinite(x)
-            and not (nonneg and x < 0)
-            for x in v
-        )  # fmt: skip
-        if not ok:
-            sign = "non-negative " if nonneg else ""
-            raise ModelFileError(f"{at}.{key}: expected three finite {sign}numbers (x, y, z)")
-        out.append(np.array(v, dtype=np.float64))
-    return out[0], out[1]
+    return _term_from_dict(
+        t, kind, at, "k2", ("accel", "an accelerometer triad"), ("g^2", "g²"), _vector3
+    )
 
 
 def _count_scale_from_dict(cs: Any, unit: str, at: str) -> float | None:
