@@ -647,8 +647,9 @@ def resolve_unit(
         parameter (``"{temp_conversion} (raw counts)"``); default: the role's unit
         parameter (``signal_unit``) and the unit.
     ask : str, optional
-        A parameter's name (``"accel_unit"``; the command line shows its option): a unit
-        nobody stated is refused, asking for it.
+        The parameter that states this column's unit (``"accel_unit"``; the command line
+        shows its option): a unit nobody stated is refused, asking for it, and an option
+        contradicting the file is said under this name.
     implied : str, optional
         A unit another option implies (raw ``counts`` with a count scale), taken
         without a warning when nobody states one.
@@ -668,7 +669,8 @@ def resolve_unit(
     param = _UNIT_PARAMETER[role]
     if option:
         opt = norm(option)
-        _warn_contradicted(column, role, opt, meta, prefix, option_name)
+        stated_by = ask if ask and not ask.startswith("-") else param
+        _warn_contradicted(column, stated_by, opt, meta, prefix, option_name, role)
         return ResolvedUnit(opt, "option")
     if meta is not None:
         return ResolvedUnit(meta, "metadata")
@@ -701,15 +703,16 @@ def resolve_unit(
 
 def _warn_contradicted(
     column: str,
-    role: UnitRole,
+    param: str,
     opt: str,
     meta: str | None,
     prefix: str,
     option_name: str | None,
+    role: UnitRole,
 ) -> None:
     """A warning when the stated unit ``opt`` contradicts the file's metadata or the unit
-    in the column's name (the stated one is used)."""
-    param = _UNIT_PARAMETER[role]
+    in the column's name (the stated one is used); ``param`` is the parameter that stated
+    it."""
     said = option_name or f"{{{param}}} {opt}"
     named_params = (param, *_PLACEHOLDER.findall(option_name or ""))
     if meta is not None and meta != opt:

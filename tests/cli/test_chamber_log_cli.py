@@ -118,7 +118,7 @@ def test_profile_correlate_two_chamber_logs(
 
 RECORDING_COMMANDS = (
     "inspect", "fit", "validate", "allan", "metrics", "noise", "report", "ratetable",
-    "turntable", "multipos", "profile join", "compensate",
+    "turntable", "multipos", "profile join", "compensate", "tumble",
 )  # fmt: skip
 """The commands that read a sensor's recording and take its chamber log (compensate joins
 it once and then chunk by chunk)."""

@@ -11,6 +11,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from bag_writer import NS, Topic, write_bag
 from thermocal.cli import main
 from thermocal.ratetable.simulate import simulate_ladder
 from thermocal.writers import write_recording
@@ -368,3 +369,49 @@ def test_start_without_a_dwell_refused(
     _one_line_error(capsys, "--start", "--dwell")
     assert main(["ratetable", str(path), "--dwell", "20"]) == 2
     _one_line_error(capsys, "--dwell", "--rates")
+
+
+def test_a_ladder_from_a_bag_topic_and_its_stamps(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A ladder logged in a ROS bag beside a second IMU: --topic picks the table's IMU (rad/s,
+    so the scale factor is dimensionless); --stamp receive reads the recorder's clock, here
+    running at half the header stamps' pace: the plateaus' times double."""
+    rec, truth = simulate_ladder(np.random.default_rng(11), rates_dps=LADDER, dwell_s=10.0,
+                                 rate_hz=50.0)  # fmt: skip
+    n = rec.n_samples
+    header = (1_700_000_000 * NS + np.round(rec.time_s * NS)).astype(np.int64)
+    receive = header[0] + 2 * (header - header[0])
+    imu = np.zeros((n, 6))
+    imu[:, 2] = np.deg2rad(rec.columns["gyro"])  # the table's axis: z, in rad/s
+    imu[:, 5] = 9.80665
+    bag = write_bag(tmp_path / "ladder.bag", "ros1", [
+        Topic("/imu_table", "sensor_msgs/msg/Imu", header, receive, imu),
+        Topic("/imu_room", "sensor_msgs/msg/Imu", header, receive, np.zeros((n, 6))),
+    ])  # fmt: skip
+    rates = ",".join(f"{r:g}" for r in LADDER)
+    base = ["ratetable", str(bag), "--gyro", "gyro_z", f"--rates={rates}", "--json"]
+    got = {}
+    for stamp in ("header", "receive"):
+        assert main([*base, "--topic", "/imu_table", "--stamp", stamp]) == 0
+        got[stamp] = json.loads(capsys.readouterr().out)
+    k = np.polyfit(np.array(LADDER), np.array(truth["outputs"]), 1)[0]
+    for res in got.values():
+        ld = res["ladders"][0]
+        assert res["scale_factor_unit"] == "1"
+        assert abs(ld["scale_factor"] - k) < 4 * ld["scale_factor_sigma"]
+    ends = [[p["end_s"] for p in got[s]["plateaus"][0]["plateaus"]] for s in got]
+    assert np.allclose(ends[1], 2.0 * np.array(ends[0]), atol=1.0), ends
+    assert main(base) == 2  # two Imu topics, none named
+    _one_line_error(capsys, "--topic")
+
+
+def test_a_gyro_unit_against_the_file_is_said_as_typed(
+    ladder_csv: tuple[Path, dict], capsys: pytest.CaptureFixture[str]
+) -> None:
+    path, _ = ladder_csv  # the file says deg/s
+    rates = ",".join(f"{r:g}" for r in LADDER)
+    assert main(["ratetable", str(path), f"--rates={rates}", "--gyro-unit", "counts"]) == 0
+    err = capsys.readouterr().err
+    assert "--gyro-unit counts contradicts the file's metadata" in err, err
+    assert "--signal-unit" not in err

@@ -12,10 +12,16 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from bag_writer import NS, Topic, write_bag
+from chamber_logs import air_c, write_log
 from thermocal.cli import main
 from thermocal.recording import Recording
 from thermocal.tumble.simulate import simulate_tumble
 from thermocal.writers import write_recording
+
+
+G_MG = 9.80665e-3
+"""One mg in m/s² (standard gravity 9.80665 m/s², CGPM 1901)."""
 
 
 def _sha(p: Path) -> str:
@@ -165,3 +171,85 @@ def test_the_report_page(
     same = ["-o", str(tmp_path / "x.html"), "--report", str(tmp_path / "x.html")]
     assert main(["tumble", str(path), "--angle-column", "angle", *same]) == 2
     _one_line_error(capsys, "-o and --report")
+
+
+def test_the_chamber_log_gives_the_test_temperature(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A tumble run 2000 s into the chamber log's clock, on its 20 → 60 °C ramp: the
+    temperature and each station's from the log (°F, every 10 s), against the air the log
+    was written from (tests/helpers/chamber_logs)."""
+    rec, _ = simulate_tumble(np.random.default_rng(1), stations=12, dwell_s=10.0)
+    p = tmp_path / "tb.csv"
+    write_recording(rec, p)
+    log = write_log(tmp_path / "log.csv", style="hh:mm:ss", period_s=10.0, unit="degF")
+    chamber = ["--chamber-log", f"{log}:Chamber PV", "--chamber-offset", "2000"]
+    assert main(["tumble", str(p), "--angle-column", "angle", *chamber, "--json"]) == 0
+    res = json.loads(capsys.readouterr().out)
+    t = rec.time_s
+    air = air_c(2000.0 + t)  # the air at each sample
+    temp = res["temperature"]
+    assert temp["column"] == "chamber"
+    assert temp["mean_c"] == pytest.approx(float(np.mean(air)), abs=0.01)
+    assert (temp["min_c"], temp["max_c"]) == (
+        pytest.approx(float(air.min()), abs=0.01), pytest.approx(float(air.max()), abs=0.01)
+    )
+    assert len(res["stations"]) == 12
+    for s in res["stations"]:
+        kept = (t >= s["start_s"]) & (t <= s["end_s"])
+        assert s["temp_c"] == pytest.approx(float(np.mean(air[kept])), abs=0.01)
+    # the same through --temps chamber, and in the text
+    assert main(["tumble", str(p), "--angle-column", "angle", "--temps", "chamber", *chamber]) == 0
+    assert f"temperature (chamber): {temp['mean_c']:.2f} °C mean" in capsys.readouterr().out
+    # without a log: no temperature; a chamber option alone is refused
+    assert main(["tumble", str(p), "--angle-column", "angle", "--json"]) == 0
+    res = json.loads(capsys.readouterr().out)
+    assert res["temperature"] is None and res["stations"][0]["temp_c"] is None
+    assert main(["tumble", str(p), "--angle-column", "angle", "--chamber-offset", "2000"]) == 2
+    _one_line_error(capsys, "--chamber-offset applies with --chamber-log")
+
+
+def test_a_continuous_tumble_from_a_bag_topic_and_its_stamps(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A continuous tumble at 2 °/s logged in a ROS bag beside another IMU: --topic picks
+    it; its receive stamps run at half the header stamps' pace (a recorder's clock), so
+    with --stamp receive the head turns at 1 °/s of that clock."""
+    rec, truth = simulate_tumble(np.random.default_rng(2), turn_rate_dps=2.0, rate_hz=10.0)
+    n = rec.n_samples
+    header = (1_700_000_000 * NS + np.round(rec.time_s * NS)).astype(np.int64)
+    receive = header[0] + 2 * (header - header[0])
+    imu = np.zeros((n, 6))
+    imu[:, 5] = rec.columns["accel"] * G_MG  # mg → m/s²
+    other = np.zeros((n, 6))
+    other[:, 5] = 9.80665
+    bag = write_bag(tmp_path / "tumble.bag", "ros1", [
+        Topic("/imu_head", "sensor_msgs/msg/Imu", header, receive, imu),
+        Topic("/imu_base", "sensor_msgs/msg/Imu", header, receive, other),
+    ])  # fmt: skip
+    base = ["tumble", str(bag), "--accel", "accel_z", "--topic", "/imu_head", "--json"]
+    for extra in (["--turn-rate", "2"], ["--stamp", "receive", "--turn-rate", "1"]):
+        assert main([*base, *extra]) == 0, capsys.readouterr().err
+        res = json.loads(capsys.readouterr().out)
+        assert res["output_unit"] == "m/s^2" and res["mode"] == "continuous"
+        for k in ("k0", "k1", "k2", "k_ip"):
+            want = truth[k] * G_MG
+            assert abs(res["coefficients"][k] - want) < 3 * res["sigmas"][k], (extra, k)
+    # the receive stamps at 2 °/s: the angles twice what they were, the fit far off
+    assert main([*base, "--stamp", "receive", "--turn-rate", "2"]) == 0
+    res = json.loads(capsys.readouterr().out)
+    assert abs(res["coefficients"]["k1"] - truth["k1"] * G_MG) > 10 * res["sigmas"]["k1"]
+    # two Imu topics and none named: the refusal names --topic
+    assert main(["tumble", str(bag), "--accel", "accel_z", "--turn-rate", "2"]) == 2
+    _one_line_error(capsys, "--topic")
+
+
+@pytest.mark.parametrize("unit", ["ug", "counts"])
+def test_an_accel_unit_against_the_file_is_said_as_typed(
+    unit: str, sim: tuple[Path, dict], capsys: pytest.CaptureFixture[str]
+) -> None:
+    path, _ = sim  # the file says mg (and its values are not whole counts)
+    assert main(["tumble", str(path), "--angle-column", "angle", "--accel-unit", unit]) == 0
+    err = capsys.readouterr().err
+    assert f"--accel-unit {unit} contradicts the file's metadata" in err, err
+    assert "--signal-unit" not in err

@@ -4,12 +4,13 @@ the same object as the command computed, and a file that is not one refused."""
 from __future__ import annotations
 
 import json
+import warnings
 from pathlib import Path
 
 import numpy as np
 import pytest
 
-from thermocal.errors import ThermocalInputError
+from thermocal.errors import ThermocalInputError, UnitWarning
 from thermocal.pipeline.ratetable import RateTableOptions, ratetable_files, read_result
 from thermocal.ratetable.simulate import simulate_temperatures
 from thermocal.writers import write_recording
@@ -52,3 +53,16 @@ def test_not_a_result_refused(result_file: tuple[Path, dict], tmp_path: Path) ->
             read_result(bad)
     with pytest.raises(ThermocalInputError, match="cannot read"):
         read_result(tmp_path / "missing.json")
+
+
+def test_a_gyro_unit_against_the_file_names_gyro_unit(tmp_path: Path) -> None:
+    rec, _ = simulate_temperatures(np.random.default_rng(1), [25.0], rates_dps=LADDER,
+                                   dwell_s=8.0, rate_hz=50.0)[0]  # fmt: skip
+    path = tmp_path / "deg_s.csv"  # the file says deg/s
+    write_recording(rec, path)
+    with warnings.catch_warnings(record=True) as caught:  # and the counts' plausibility
+        warnings.simplefilter("always")
+        ratetable_files([path], RateTableOptions(gyro_unit="counts", rate_column="table_rate"))
+    said = [str(w.message) for w in caught
+            if issubclass(w.category, UnitWarning) and "contradicts" in str(w.message)]  # fmt: skip
+    assert len(said) == 1 and "gyro_unit counts contradicts the file's metadata" in said[0], said

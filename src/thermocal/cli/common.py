@@ -41,12 +41,13 @@ if TYPE_CHECKING:
     import numpy as np
     from rich.console import Console
 
-    from thermocal import units
+    from thermocal import units, writers
     from thermocal.readers.options import ChamberLogSpec, ReadOptions
 else:
     # this module is imported to register commands (``--help``): nothing heavy at import
     np = LazyModule("numpy")
     units = LazyModule("thermocal.units")
+    writers = LazyModule("thermocal.writers")
 
 P = ParamSpec("P")
 R = TypeVar("R")
@@ -658,3 +659,101 @@ def read_options(**given: Any) -> ReadOptions:
     r = _read_options(**given)
     spec = _CHAMBER.get()
     return r if spec is None else r.replace(chamber_log=spec)
+
+
+# --- how a file is read, and a result's files (the commands of one test: tumble, ratetable) ---
+
+ResultOpt = Annotated[
+    Path | None, typer.Option("-o", "--output", help="Also write the result as JSON here.")
+]
+"""``-o`` of a command whose result also goes to a JSON file (beside ``--report``)."""
+
+_FILE_READ_OPTIONS: tuple[tuple[str, Any, Any], ...] = (
+    ("names", NamesOpt, None), ("topic", TopicOpt, None), ("stamp", StampOpt, "header"),
+    ("rate", RateOpt, None), ("on_bad_lines", OnBadLinesOpt, "error"),
+    ("delimiter", DelimiterOpt, None), ("decimal", DecimalOpt, None),
+)  # fmt: skip
+"""How a file is read beyond its columns: a text log's layout, a flight log's topic, a bag's
+topic and stamps (:func:`file_read_options`)."""
+
+
+def file_read_options(fn: Callable[P, R]) -> Callable[P, R]:
+    """Give a command the options of how its files are read (``--names``, ``--topic``,
+    ``--stamp``, ``--rate``, ``--on-bad-lines``, ``--delimiter``, ``--decimal``): they are
+    added to its signature in place of its parameter ``read``, which receives their
+    :func:`read_options` (with the running command's chamber log: put
+    :func:`chamber_log_options` above this decorator).
+
+    Parameters
+    ----------
+    fn : callable
+        The command's function, with a keyword parameter ``read``.
+
+    Returns
+    -------
+    callable
+        The command with the options.
+    """
+    sig = inspect.signature(fn)  # ``read``'s annotation may name a type not imported
+    extra = [inspect.Parameter(n, inspect.Parameter.KEYWORD_ONLY, annotation=a, default=d)
+             for n, a, d in _FILE_READ_OPTIONS]  # fmt: skip
+    kept = [p for p in sig.parameters.values() if p.name != "read"]
+
+    @functools.wraps(fn)
+    def wrapper(*args: P.args, **kwargs: P.kwargs) -> R:
+        given = {n: kwargs.pop(n, d) for n, _, d in _FILE_READ_OPTIONS}
+        return fn(*args, read=read_options(**given), **kwargs)
+
+    wrapper.__signature__ = sig.replace(parameters=[*kept, *extra])  # type: ignore[attr-defined]
+    wrapper.__annotations__ = {
+        **{p.name: p.annotation for p in kept},
+        **{n: a for n, a, _ in _FILE_READ_OPTIONS},
+    }
+    return wrapper
+
+
+def check_result_outputs(
+    output: Path | None, report: Path | None, inputs: list[str | Path]
+) -> None:
+    """Refuse a result's JSON (``-o``) or HTML page (``--report``) over an input, or both
+    in one file.
+
+    Parameters
+    ----------
+    output, report : Path or None
+        The files asked for.
+    inputs : list of str or Path
+        The command's input files.
+
+    Raises
+    ------
+    ThermocalInputError
+        An output over an input (:func:`thermocal.writers.check_not_input`), or ``-o`` and
+        ``--report`` naming one file.
+    """
+    for out in (output, report):
+        if out is not None:
+            writers.check_not_input(out, inputs)
+    if output is not None and output == report:
+        raise ThermocalInputError("-o and --report name the same file; give two files")
+
+
+def write_result_outputs(
+    result: dict[str, Any], output: Path | None, report: Path | None, html: Callable[[], str]
+) -> None:
+    """Write a result's JSON (``-o``) and HTML page (``--report``, ``html()`` built only
+    then), each to a temporary renamed.
+
+    Parameters
+    ----------
+    result : dict
+        The result as JSON.
+    output, report : Path or None
+        The files asked for.
+    html : callable
+        Builds the page.
+    """
+    if output is not None:
+        writers.write_json(output, result)
+    if report is not None:
+        writers.write_html(report, html())

@@ -17,20 +17,18 @@ import typer
 from thermocal._lazy import LazyModule
 from thermocal.cli.application import app
 from thermocal.cli.common import (
-    DecimalOpt,
-    DelimiterOpt,
     JsonOpt,
-    NamesOpt,
-    OnBadLinesOpt,
-    RateOpt,
+    ResultOpt,
     TimeOpt,
     TimeUnitOpt,
     chamber_log_options,
+    check_result_outputs,
     emit,
+    file_read_options,
     handle_errors,
-    read_options,
     show,
     split_floats,
+    write_result_outputs,
 )
 from thermocal.errors import ThermocalInputError
 
@@ -38,12 +36,11 @@ if TYPE_CHECKING:
     import thermocal.pipeline.ratetable as _files
     import thermocal.report.ratetable as _report
     import thermocal.report.ratetable_text as _text
-    import thermocal.writers as _writers
+    from thermocal.readers.options import ReadOptions
 else:
     _files = LazyModule("thermocal.pipeline.ratetable")
     _report = LazyModule("thermocal.report.ratetable")
     _text = LazyModule("thermocal.report.ratetable_text")
-    _writers = LazyModule("thermocal.writers")
 
 FilesArg = Annotated[
     list[Path],
@@ -152,9 +149,6 @@ ReportOpt = Annotated[
     Path | None,
     typer.Option("--report", help="Also write the spec sheet as a self-contained HTML page."),
 ]
-ResultOpt = Annotated[
-    Path | None, typer.Option("-o", "--output", help="Also write the result as JSON here.")
-]
 
 
 _DURATION = re.compile(r"^\s*([-+0-9.eE]+)\s*(s|min|h)?\s*$")
@@ -183,10 +177,11 @@ def _dwells(text: str | None) -> tuple[float, ...] | None:
 @app.command("ratetable")
 @handle_errors
 @chamber_log_options
+@file_read_options
 def ratetable_cmd(
     files: FilesArg,
     gyro: GyroOpt = "gyro",
-    signal_unit: GyroUnitOpt = None,
+    signal_unit: GyroUnitOpt = None,  # so that the reader's {signal_unit} reads --gyro-unit
     rate_column: RateColumnOpt = None,
     rates_dps: RatesOpt = None,
     schedule: ScheduleOpt = None,
@@ -205,22 +200,15 @@ def ratetable_cmd(
     report: ReportOpt = None,
     time: TimeOpt = None,
     time_unit: TimeUnitOpt = None,
-    t_names: NamesOpt = None,
-    t_rate: RateOpt = None,
-    t_bad: OnBadLinesOpt = "error",
-    t_delim: DelimiterOpt = None,
-    t_dec: DecimalOpt = None,
     as_json: JsonOpt = False,
+    *,
+    read: "ReadOptions",
 ) -> None:
     """Gyro scale factor, nonlinearity, asymmetry, bias per rate, input threshold and
     resolution from a rate-table ladder (IEEE Std 952/1431); with --temps at several
     temperatures, the scale factor's temperature coefficient."""
     inputs: list[str | Path] = [*files, *([schedule] if schedule else [])]
-    for out in (output, report):
-        if out is not None:
-            _writers.check_not_input(out, inputs)
-    if output is not None and output == report:
-        raise ThermocalInputError("-o and --report name the same file; give two files")
+    check_result_outputs(output, report, inputs)
     rates = split_floats(rates_dps, "--rates")
     opts = _files.RateTableOptions(
         gyro,
@@ -235,9 +223,7 @@ def ratetable_cmd(
         temp_gap_c,
         time,
         time_unit,
-        read_options(
-            names=t_names, rate=t_rate, on_bad_lines=t_bad, delimiter=t_delim, decimal=t_dec
-        ),
+        read,
         one_direction,
         tolerance_dps,
         _dwells(dwell_s),
@@ -245,10 +231,7 @@ def ratetable_cmd(
         accel_dps2,
     )
     res = _files.ratetable_files(files, opts, schedule=schedule)
-    if output is not None:
-        _writers.write_json(output, res.to_dict())
-    if report is not None:
-        _writers.write_html(report, _report.ratetable_html(res))
+    write_result_outputs(res.to_dict(), output, report, lambda: _report.ratetable_html(res))
     emit(res.to_dict(), as_json, lambda: show(_text.ratetable_text(res)))
 
 

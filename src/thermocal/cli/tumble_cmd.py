@@ -14,31 +14,28 @@ import typer
 from thermocal._lazy import LazyModule
 from thermocal.cli.application import app
 from thermocal.cli.common import (
-    DecimalOpt,
-    DelimiterOpt,
     JsonOpt,
-    NamesOpt,
-    OnBadLinesOpt,
-    RateOpt,
+    ResultOpt,
     TimeOpt,
     TimeUnitOpt,
+    chamber_log_options,
+    check_result_outputs,
     emit,
+    file_read_options,
     handle_errors,
-    read_options,
     show,
+    write_result_outputs,
 )
-from thermocal.errors import ThermocalInputError
 
 if TYPE_CHECKING:
     import thermocal.pipeline.tumble as _files
     import thermocal.report.tumble as _report
     import thermocal.report.tumble_text as _text
-    import thermocal.writers as _writers
+    from thermocal.readers.options import ReadOptions
 else:
     _files = LazyModule("thermocal.pipeline.tumble")
     _report = LazyModule("thermocal.report.tumble")
     _text = LazyModule("thermocal.report.tumble_text")
-    _writers = LazyModule("thermocal.writers")
 
 FileArg = Annotated[
     Path,
@@ -89,21 +86,28 @@ AngleToleranceOpt = Annotated[
         help="Largest change of the angle between two samples of one station [°].",
     ),
 ]
+TempsOpt = Annotated[
+    str | None,
+    typer.Option(
+        "--temps",
+        help="The temperature column the test ran at (chamber: the --chamber-log's, the "
+        "default with a chamber log): its mean and span, and each station's.",
+    ),
+]
 ReportOpt = Annotated[
     Path | None,
     typer.Option("--report", help="Also write the result as a self-contained HTML page."),
-]
-ResultOpt = Annotated[
-    Path | None, typer.Option("-o", "--output", help="Also write the result as JSON here.")
 ]
 
 
 @app.command("tumble")
 @handle_errors
+@chamber_log_options
+@file_read_options
 def tumble_cmd(
     file: FileArg,
     accel: AccelOpt = "accel",
-    accel_unit: AccelUnitOpt = None,
+    signal_unit: AccelUnitOpt = None,  # so that the reader's {signal_unit} reads --accel-unit
     angle_column: AngleColumnOpt = None,
     angle_unit: AngleUnitOpt = None,
     turn_rate_dps: TurnRateOpt = None,
@@ -112,27 +116,21 @@ def tumble_cmd(
     settle_s: SettleOpt = 1.0,
     min_station_s: MinStationOpt = 2.0,
     angle_tolerance_deg: AngleToleranceOpt = 0.01,
+    temps: TempsOpt = None,
     output: ResultOpt = None,
     report: ReportOpt = None,
     time: TimeOpt = None,
     time_unit: TimeUnitOpt = None,
-    t_names: NamesOpt = None,
-    t_rate: RateOpt = None,
-    t_bad: OnBadLinesOpt = "error",
-    t_delim: DelimiterOpt = None,
-    t_dec: DecimalOpt = None,
     as_json: JsonOpt = False,
+    *,
+    read: "ReadOptions",
 ) -> None:
     """Accelerometer bias, scale factor, misalignment, second-order K2 and cross-coupling Kip
     from a tumble test (IEEE Std 1293-1998): the output's harmonics against the angle."""
-    for out in (output, report):
-        if out is not None:
-            _writers.check_not_input(out, [file])
-    if output is not None and output == report:
-        raise ThermocalInputError("-o and --report name the same file; give two files")
+    check_result_outputs(output, report, [file])
     opts = _files.TumbleOptions(
         accel,
-        accel_unit,
+        signal_unit,
         angle_column,
         angle_unit,
         turn_rate_dps,
@@ -143,15 +141,11 @@ def tumble_cmd(
         angle_tolerance_deg,
         time,
         time_unit,
-        read_options(
-            names=t_names, rate=t_rate, on_bad_lines=t_bad, delimiter=t_delim, decimal=t_dec
-        ),
+        read,
+        temps,
     )
     res = _files.tumble_file(file, opts)
-    if output is not None:
-        _writers.write_json(output, res.to_dict())
-    if report is not None:
-        _writers.write_html(report, _report.tumble_html(res))
+    write_result_outputs(res.to_dict(), output, report, lambda: _report.tumble_html(res))
     emit(res.to_dict(), as_json, lambda: show(_text.tumble_text(res)))
 
 

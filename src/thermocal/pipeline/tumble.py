@@ -18,7 +18,7 @@ import numpy as np
 from thermocal import units
 from thermocal.errors import ParameterError, ThermocalInputError
 from thermocal.readers import read_recording
-from thermocal.readers.options import ReadOptions
+from thermocal.readers.options import CHAMBER_COLUMN, ReadOptions
 from thermocal.tumble.analysis import (
     HARMONICS,
     HarmonicFit,
@@ -69,7 +69,11 @@ class TumbleOptions:
     time, time_unit : str or None
         The time column and its unit.
     read : ReadOptions or None
-        How a text log is read.
+        How the file is read: a text log's layout, a flight log's or bag's topic and stamps,
+        a chamber's own log joined by time (``chamber_log``).
+    temps : str or None
+        The temperature column the test ran at (the recording's own, or ``"chamber"``: the
+        joined chamber log's); None: the chamber log's when ``read`` joins one, else none.
     """
 
     accel: str = "accel"
@@ -85,6 +89,7 @@ class TumbleOptions:
     time: str | None = None
     time_unit: str | None = None
     read: ReadOptions | None = None
+    temps: str | None = None
 
     def __post_init__(self) -> None:
         if (self.angle_column is None) == (self.turn_rate_dps is None):
@@ -128,6 +133,8 @@ class TumbleResult:
         The accelerometer output's unit.
     settle_s : float
         Left out at each station's start [s].
+    temperature : TumbleTemperature or None
+        The temperature the test ran at (None: no temperature column).
     """
 
     file: str
@@ -138,6 +145,7 @@ class TumbleResult:
     coefficients: TumbleCoefficients
     output_unit: str
     settle_s: float
+    temperature: TumbleTemperature | None = None
 
     def coefficient_units(self) -> dict[str, str]:
         """Each coefficient's unit: the output's unit per g to its order (δ_o in rad)."""
@@ -169,25 +177,79 @@ class TumbleResult:
             **to_dict(self.fit, c),
             "significant": dict(zip(c.names, sig, strict=True)),
             "settle_s": self.settle_s,
-            "stations": [_station_dict(s) for s in self.stations],
+            "temperature": None if self.temperature is None else self.temperature.to_dict(),
+            "stations": [_station_dict(s, self.temperature, k) for k, s in
+                         enumerate(self.stations)],  # fmt: skip
             "dropped": [list(d) for d in self.dropped],
             "note": K_PP_NOTE,
         }
 
 
-def _station_dict(s: Station) -> dict[str, Any]:
-    """One station as JSON."""
+def _station_dict(s: Station, temp: TumbleTemperature | None, k: int) -> dict[str, Any]:
+    """One station as JSON (its mean temperature with a temperature column)."""
     return {"start_s": s.start_s, "end_s": s.end_s, "angle_deg": s.angle_deg, "mean": s.mean,
-            "se": s.se, "n": s.n}  # fmt: skip
+            "se": s.se, "n": s.n,
+            "temp_c": None if temp is None else temp.stations_c[k]}  # fmt: skip
+
+
+@dataclass(frozen=True)
+class TumbleTemperature:
+    """The temperature a tumble test ran at.
+
+    Attributes
+    ----------
+    column : str
+        The temperature column (``chamber``: a chamber's own log joined by time).
+    mean_c, min_c, max_c : float
+        Its mean, least and greatest value over the record [°C].
+    stations_c : tuple of float
+        Each station's mean over its kept samples [°C] (empty for a continuous tumble).
+    """
+
+    column: str
+    mean_c: float
+    min_c: float
+    max_c: float
+    stations_c: tuple[float, ...] = ()
+
+    def to_dict(self) -> dict[str, Any]:
+        """The JSON object ``temperature`` (the stations' means go with each station)."""
+        return {"column": self.column, "mean_c": self.mean_c, "min_c": self.min_c,
+                "max_c": self.max_c}  # fmt: skip
+
+
+def _temp_column(o: TumbleOptions) -> str | None:
+    """The temperature column asked for: ``temps``, else a joined chamber log's."""
+    if o.temps is not None:
+        return o.temps
+    return CHAMBER_COLUMN if o.read is not None and o.read.chamber_log is not None else None
+
+
+def _temperature(
+    rec: Any, col: str | None, stations: list[Station]
+) -> TumbleTemperature | None:
+    """The record's temperature (mean, least, greatest [°C]) and each station's mean over
+    the samples its mean took (``start_s`` ≤ t ≤ ``end_s``)."""
+    if col is None:
+        return None
+    t = np.asarray(rec.time_s, float)
+    temp = np.asarray(rec.temperature_c(col), float)
+    per = tuple(
+        float(np.mean(temp[(t >= s.start_s) & (t <= s.end_s)])) for s in stations
+    )
+    return TumbleTemperature(col, float(np.mean(temp)), float(np.min(temp)),
+                             float(np.max(temp)), per)  # fmt: skip
 
 
 def _read(path: Path, o: TumbleOptions) -> tuple[Any, np.ndarray, str]:
     """The recording, its accelerometer output and that output's unit."""
+    temp = _temp_column(o)
     read = (o.read or ReadOptions()).replace(
-        time=o.time, time_unit=o.time_unit, signals=(o.accel,), signal_unit=o.accel_unit
-    )
+        time=o.time, time_unit=o.time_unit, signals=(o.accel,), signal_unit=o.accel_unit,
+        **({"temperatures": (temp,)} if temp is not None else {}),
+    )  # fmt: skip
     rec = read_recording(path, read, ask_units={o.accel: "accel_unit"})
-    rec.validate(required=[o.accel])
+    rec.validate(required=[o.accel, *([temp] if temp is not None else [])])
     unit = units.normalize_signal_unit(rec.units[o.accel])
     if units.signal_kind(unit) == "rate":
         raise ThermocalInputError.naming(
@@ -288,4 +350,5 @@ def tumble_file(path: Path, opts: TumbleOptions) -> TumbleResult:
         coefficients_from_harmonics(fit),
         unit,
         opts.settle_s,
+        _temperature(rec, _temp_column(opts), stations),
     )

@@ -54,6 +54,10 @@ def tumble_text(res: TumbleResult) -> list[Block]:
     else:
         head = f"{res.file}: a continuous tumble, {fit.n_points} samples"
     out: list[Block] = [head]
+    if res.temperature is not None:
+        tt = res.temperature
+        out.append(f"  temperature ({tt.column}): {tt.mean_c:.2f} °C mean, {tt.min_c:.2f} to "
+                   f"{tt.max_c:.2f} °C")  # fmt: skip
     if res.dropped:
         spans = ", ".join(f"{a:.0f}-{b:.0f} s" for a, b in res.dropped[:8])
         out.append(f"  {len(res.dropped)} steady stretch(es) too short, left out: {spans}")
