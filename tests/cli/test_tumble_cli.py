@@ -19,7 +19,6 @@ from thermocal.recording import Recording
 from thermocal.tumble.simulate import simulate_tumble
 from thermocal.writers import write_recording
 
-
 G_MG = 9.80665e-3
 """One mg in m/s² (standard gravity 9.80665 m/s², CGPM 1901)."""
 
@@ -192,7 +191,8 @@ def test_the_chamber_log_gives_the_test_temperature(
     assert temp["column"] == "chamber"
     assert temp["mean_c"] == pytest.approx(float(np.mean(air)), abs=0.01)
     assert (temp["min_c"], temp["max_c"]) == (
-        pytest.approx(float(air.min()), abs=0.01), pytest.approx(float(air.max()), abs=0.01)
+        pytest.approx(float(air.min()), abs=0.01),
+        pytest.approx(float(air.max()), abs=0.01),
     )
     assert len(res["stations"]) == 12
     for s in res["stations"]:

@@ -7,37 +7,28 @@ from __future__ import annotations
 
 import json
 import re
-from pathlib import Path
 
 import numpy as np
 import pytest
 
-from tutorial_pages import _numbers, _run_in_scratch
+from tutorial_pages import Page, _numbers, assert_prints_as_shown, run_page
 
 PAGE = "ratetable.md"
 
 
 @pytest.fixture(scope="module")
-def page(tmp_path_factory: pytest.TempPathFactory) -> tuple[list[tuple[str, str]], Path]:
-    tmp = tmp_path_factory.mktemp("ratetable")
-    return _run_in_scratch(tmp, PAGE), tmp
+def page(tmp_path_factory: pytest.TempPathFactory) -> Page:
+    return run_page(tmp_path_factory, PAGE)
 
 
 def test_ratetable_tutorial_prints_what_the_page_shows(
-    page: tuple[list[tuple[str, str]], Path],
+    page: Page,
 ) -> None:
-    pairs, _ = page
-    assert len(pairs) == 6
-    for printed, shown in pairs:
-        assert _numbers(printed) == _numbers(shown)
-        # stripped both sides: rich versions pad a table's title differently (centred with
-        # leading spaces on the floor's rich, flush on the lock's)
-        lines = [ln.strip() for ln in printed.strip().splitlines()]
-        assert lines == [ln.strip() for ln in shown.strip().splitlines()]
+    assert_prints_as_shown(page[0], 6)
 
 
 def test_ratetable_tutorial_figures_are_the_simulated_truth(
-    page: tuple[list[tuple[str, str]], Path],
+    page: Page,
 ) -> None:
     pairs, tmp = page
     truth = json.loads((tmp / "truth.json").read_text())
@@ -58,7 +49,7 @@ def test_ratetable_tutorial_figures_are_the_simulated_truth(
 
 
 def test_ratetable_tutorial_program_start_is_the_truths(
-    page: tuple[list[tuple[str, str]], Path],
+    page: Page,
 ) -> None:
     pairs, tmp = page
     truth = json.loads((tmp / "program.json").read_text())["files"][0]

@@ -72,3 +72,25 @@ def _run_in_scratch(tmp: Path, name: str) -> list[tuple[str, str]]:
         fresh_cli(mp)
         mp.chdir(tmp)
         return _run_page(TUTORIALS / name)
+
+
+Page = tuple[list[tuple[str, str]], Path]
+"""A page run: (printed, shown) for each executable block, and the folder it ran in."""
+
+
+def run_page(factory: pytest.TempPathFactory, name: str) -> Page:
+    """Run the tutorial ``name`` (``"tumble.md"``) in a new empty folder (named after it);
+    for a module-scoped fixture."""
+    tmp = factory.mktemp(Path(name).stem)
+    return _run_in_scratch(tmp, name), tmp
+
+
+def assert_prints_as_shown(pairs: list[tuple[str, str]], blocks: int) -> None:
+    """The page's ``blocks`` executable blocks each printed what the page shows: the same
+    numbers, and the same lines stripped on both sides (rich versions pad a table's title
+    differently: centred with leading spaces on the floor's rich, flush on the lock's)."""
+    assert len(pairs) == blocks
+    for printed, shown in pairs:
+        assert _numbers(printed) == _numbers(shown)
+        lines = [ln.strip() for ln in printed.strip().splitlines()]
+        assert lines == [ln.strip() for ln in shown.strip().splitlines()]

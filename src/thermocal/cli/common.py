@@ -702,7 +702,7 @@ def file_read_options(fn: Callable[P, R]) -> Callable[P, R]:
     @functools.wraps(fn)
     def wrapper(*args: P.args, **kwargs: P.kwargs) -> R:
         given = {n: kwargs.pop(n, d) for n, _, d in _FILE_READ_OPTIONS}
-        return fn(*args, read=read_options(**given), **kwargs)
+        return fn(*args, read=read_options(**given), **kwargs)  # type: ignore[arg-type]
 
     wrapper.__signature__ = sig.replace(parameters=[*kept, *extra])  # type: ignore[attr-defined]
     wrapper.__annotations__ = {

@@ -178,8 +178,9 @@ class TumbleResult:
             "significant": dict(zip(c.names, sig, strict=True)),
             "settle_s": self.settle_s,
             "temperature": None if self.temperature is None else self.temperature.to_dict(),
-            "stations": [_station_dict(s, self.temperature, k) for k, s in
-                         enumerate(self.stations)],  # fmt: skip
+            "stations": [
+                _station_dict(s, self.temperature, k) for k, s in enumerate(self.stations)
+            ],
             "dropped": [list(d) for d in self.dropped],
             "note": K_PP_NOTE,
         }
@@ -225,18 +226,14 @@ def _temp_column(o: TumbleOptions) -> str | None:
     return CHAMBER_COLUMN if o.read is not None and o.read.chamber_log is not None else None
 
 
-def _temperature(
-    rec: Any, col: str | None, stations: list[Station]
-) -> TumbleTemperature | None:
+def _temperature(rec: Any, col: str | None, stations: list[Station]) -> TumbleTemperature | None:
     """The record's temperature (mean, least, greatest [°C]) and each station's mean over
     the samples its mean took (``start_s`` ≤ t ≤ ``end_s``)."""
     if col is None:
         return None
     t = np.asarray(rec.time_s, float)
     temp = np.asarray(rec.temperature_c(col), float)
-    per = tuple(
-        float(np.mean(temp[(t >= s.start_s) & (t <= s.end_s)])) for s in stations
-    )
+    per = tuple(float(np.mean(temp[(t >= s.start_s) & (t <= s.end_s)])) for s in stations)
     return TumbleTemperature(col, float(np.mean(temp)), float(np.min(temp)),
                              float(np.max(temp)), per)  # fmt: skip
 
