@@ -9,7 +9,9 @@ its own example session (``tests/data/imucal_ferraris``, MIT).
 
 from __future__ import annotations
 
+import json
 import math
+import re
 
 import numpy as np
 import pytest
@@ -92,10 +94,40 @@ def test_stability_tutorial_numbers_are_stable32s(stability_page: list[tuple[str
 def test_multipos_tutorial_prints_what_the_page_shows(
     multipos_page: list[tuple[str, str]],
 ) -> None:
-    assert len(multipos_page) == 1
+    assert len(multipos_page) == 4  # multipos; the time added, compensate, the faces
     printed, shown = multipos_page[0]
     assert _numbers(printed) == _numbers(shown)
     assert len(_numbers(printed)) >= 48  # 24 parameters, value and σ
+    for printed, shown in multipos_page[1:]:
+        assert [ln.strip() for ln in printed.strip().splitlines()] == [
+            ln.strip() for ln in shown.strip().splitlines()
+        ]
+
+
+def test_multipos_tutorial_compensate_is_imucals_model(
+    multipos_page: list[tuple[str, str]],
+) -> None:
+    """The compensated faces of the page: |a| of (K_a R_a)⁻¹ (f̄ − b) with imucal's K_a R_a
+    and the bias the page prints, f̄ each face's raw mean; within 0.015 m/s² of the 9.81 the
+    session was calibrated with, their rms the fit's gravity-magnitude residual."""
+    printed = multipos_page[0][0]
+    acc = _triad_rows(printed, "accel triad")
+    bias = np.array([acc[f"bias {a}"][0] for a in "xyz"])
+    data = ROOT / "tests" / "data" / "imucal_ferraris"
+    raw = np.genfromtxt(data / "example_ferraris_session.csv", delimiter=",", names=True)
+    f = np.column_stack([raw["acc_x"], raw["acc_y"], raw["acc_z"]])
+    sections = json.loads((data / "example_ferraris_session_list.json").read_text())
+    faces = re.findall(r"^(\w+): \|a\| ([\d.]+) -> ([\d.]+) m/s\^2$", multipos_page[3][0], re.M)
+    assert [name for name, _, _ in faces] == ["x_p", "x_a", "y_p", "y_a", "z_p", "z_a"]
+    for name, before, after in faces:
+        mean = f[sections[name]["start"] : sections[name]["end"]].mean(axis=0)
+        assert float(before) == pytest.approx(np.linalg.norm(mean), abs=6e-4)
+        a = np.linalg.solve(IMUCAL_KA_RA, mean - bias)
+        assert float(after) == pytest.approx(np.linalg.norm(a), abs=2e-4), name
+        assert abs(float(after) - 9.81) < 0.015
+    rms = math.sqrt(np.mean([(float(after) - 9.81) ** 2 for _, _, after in faces]))
+    residual = re.search(r"gravity-magnitude residual rms [\d.]+ → ([\d.]+)", printed)
+    assert residual is not None and rms == pytest.approx(float(residual[1]), abs=2e-4)
 
 
 # imucal 2.6.0's FerrarisCalibration of the same session, K_g·R_g and K_a·R_a (computed in a
