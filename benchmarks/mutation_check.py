@@ -4906,6 +4906,38 @@ MUTANTS: tuple[Mutant, ...] = (
         _t("export_c_triads_k2"),
         "the C's Newton step with half the derivative: C ≠ Python",
     ),
+    Mutant(
+        "tumble-station-temp-window",
+        P + "pipeline/tumble.py",
+        "temp[(t >= s.start_s) & (t <= s.end_s)]",
+        "temp[(t >= s.start_s) | (t <= s.end_s)]",
+        _t("tumble_cli", "pipeline_tumble"),
+        "each station's temperature the whole record's (not its own samples')",
+    ),
+    Mutant(
+        "tumble-temp-max-is-mean",
+        P + "pipeline/tumble.py",
+        "float(np.max(temp)), per)",
+        "float(np.mean(temp)), per)",
+        _t("tumble_cli", "pipeline_tumble"),
+        "the test's greatest temperature given as its mean",
+    ),
+    Mutant(
+        "tumble-chamber-not-default-temp",
+        P + "pipeline/tumble.py",
+        "return CHAMBER_COLUMN if o.read is not None and o.read.chamber_log is not None else None",
+        "return None",
+        _t("tumble_cli", "pipeline_tumble"),
+        "a chamber log joined but no temperature reported without --temps chamber",
+    ),
+    Mutant(
+        "unit-contradiction-names-signal-unit",
+        P + "units.py",
+        'stated_by = ask if ask and not ask.startswith("-") else param',
+        "stated_by = param",
+        _t("pipeline_tumble", "pipeline_ratetable"),
+        "a contradicted unit said under signal_unit where accel_unit/gyro_unit stated it",
+    ),
 )
 
 
