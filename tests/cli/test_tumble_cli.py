@@ -198,9 +198,12 @@ def test_the_chamber_log_gives_the_test_temperature(
     for s in res["stations"]:
         kept = (t >= s["start_s"]) & (t <= s["end_s"])
         assert s["temp_c"] == pytest.approx(float(np.mean(air[kept])), abs=0.01)
-    # the same through --temps chamber, and in the text
-    assert main(["tumble", str(p), "--angle-column", "angle", "--temps", "chamber", *chamber]) == 0
-    assert f"temperature (chamber): {temp['mean_c']:.2f} °C mean" in capsys.readouterr().out
+    # the same through --temps chamber, in the text and on the page
+    page = tmp_path / "tb.html"
+    args = ["tumble", str(p), "--angle-column", "angle", "--temps", "chamber", *chamber]
+    assert main([*args, "--report", str(page)]) == 0
+    said = f"temperature (chamber): {temp['mean_c']:.2f} °C mean"
+    assert said in capsys.readouterr().out and said in page.read_text(encoding="utf-8")
     # without a log: no temperature; a chamber option alone is refused
     assert main(["tumble", str(p), "--angle-column", "angle", "--json"]) == 0
     res = json.loads(capsys.readouterr().out)
