@@ -256,3 +256,26 @@ def test_an_accel_unit_against_the_file_is_said_as_typed(
     err = capsys.readouterr().err
     assert f"--accel-unit {unit} contradicts the file's metadata" in err, err
     assert "--signal-unit" not in err
+
+
+def test_tumble_and_ratetable_read_files_as_fit_does() -> None:
+    """The reading options (a text log's layout, a flight log's or bag's topic and stamps,
+    the chamber's log) of fit, on the tumble and rate-table commands too."""
+    import typer
+
+    import thermocal.cli
+
+    thermocal.cli._register()
+    root = typer.main.get_command(thermocal.cli.app)
+    commands = root.commands  # type: ignore[attr-defined]
+
+    def opts(name: str) -> set[str]:
+        return {o for p in commands[name].params for o in p.opts}
+
+    reading = {"--time", "--time-unit", "--names", "--topic", "--sensor", "--stamp", "--rate",
+               "--on-bad-lines", "--delimiter", "--decimal", "--chamber-log", "--chamber-offset",
+               "--chamber-unit", "--chamber-date", "--chamber-date-order", "--chamber-drift",
+               "--chamber-tz"}  # fmt: skip
+    assert reading <= opts("fit")
+    for name in ("tumble", "ratetable"):
+        assert reading <= opts(name), (name, reading - opts(name))
