@@ -590,7 +590,8 @@ def averaging_factors(taus: TauSpec, tau0_s: float, n_samples: int) -> IntArray:
         if tau.size == 0 or not np.all(np.isfinite(tau)) or np.any(tau <= 0):
             raise ThermocalInputError("averaging times τ must be positive and finite")
         m = np.round(tau / tau0_s)
-    m = np.unique(m.astype(np.int64))
+    m = np.sort(m.astype(np.int64))
+    m = m[np.diff(m, prepend=m[:1] - 1) != 0]  # unique (np.unique imports numpy.ma)
     m = m[(m >= 1) & (m <= m_max)]
     if m.size == 0:
         raise ThermocalInputError(

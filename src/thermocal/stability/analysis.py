@@ -98,10 +98,13 @@ def check_not_stuck(
     import numpy as np
 
     v = np.asarray(values, dtype=np.float64).ravel()
-    finite = v if math.isfinite(float(v.sum())) else v[np.isfinite(v)]
+    lo, hi = (float(v.min()), float(v.max())) if v.size else (math.nan, math.nan)
+    finite = v  # a NaN makes the minimum NaN, an infinity the minimum or maximum infinite
+    if not (math.isfinite(lo) and math.isfinite(hi)):
+        finite = v[np.isfinite(v)]
+        lo, hi = (float(finite.min()), float(finite.max())) if finite.size else (0.0, 0.0)
     if finite.size < STUCK_MIN_SAMPLES:
         return
-    lo, hi = float(finite.min()), float(finite.max())
     if lo == hi:
         raise ThermocalInputError.naming(
             f"{where}: the column {name!r} is constant ({lo:.6g} in all {finite.size} "
@@ -109,13 +112,13 @@ def check_not_stuck(
             "with {" + parameter + "}, or check the sensor",
             parameter,
         )
-    probe = np.unique(finite[:_LEVEL_PROBE])
-    if probe.size > FEW_LEVELS:
+    probe = _first_levels(finite[:_LEVEL_PROBE], FEW_LEVELS + 1)
+    if len(probe) > FEW_LEVELS:
         return
-    levels = np.unique(finite) if finite.size > _LEVEL_PROBE else probe
-    if levels.size <= FEW_LEVELS:
+    levels = _first_levels(finite, FEW_LEVELS + 1) if finite.size > _LEVEL_PROBE else probe
+    if len(levels) <= FEW_LEVELS:
         warnings.warn(
-            f"{where}: the column {name!r} takes only {levels.size} distinct values in "
+            f"{where}: the column {name!r} takes only {len(levels)} distinct values in "
             f"{finite.size} samples ({', '.join(f'{x:.6g}' for x in levels)}): a stuck or "
             "flat-lined sensor, or an output step far coarser than its noise: "
             + (
@@ -126,6 +129,19 @@ def check_not_stuck(
             ConditioningWarning,
             stacklevel=2,
         )
+
+
+def _first_levels(values: FloatArray, most: int) -> list[float]:
+    """The distinct values of ``values`` (no NaN), sorted, up to ``most`` of them: one pass
+    per value found, none sorting the column (a record of noise stops after ``most``
+    passes; ``np.unique`` would sort it and import ``numpy.ma``)."""
+    found: list[float] = []
+    rest = values
+    while rest.size and len(found) < most:
+        first = rest[0]
+        found.append(float(first))
+        rest = rest[rest != first]
+    return sorted(found)
 
 
 def _tau_range(name: str, tau0_s: float, n_phase: int) -> tuple[float, float, int]:
