@@ -4906,6 +4906,63 @@ MUTANTS: tuple[Mutant, ...] = (
         _t("export_c_triads_k2"),
         "the C's Newton step with half the derivative: C ≠ Python",
     ),
+    # issue 41 slice a2-ratedefault: Welch's line removed in the frequency domain
+    Mutant(
+        "welch-first-bin-mean-kept",
+        P + "stability/periodic.py",
+        "            sp[:, 1] += mean * (seg / 4.0)\n",
+        "            sp[:, 1] -= mean * (seg / 4.0)\n",
+        _t("periodic"),
+        "the mean's leak into the first bin added instead of removed",
+    ),
+    Mutant(
+        "welch-slope-not-removed",
+        P + "stability/periodic.py",
+        "            np.subtract(sp[r], line, out=sp[r])\n",
+        "            pass\n",
+        _t("periodic"),
+        "each segment's slope left in its spectrum",
+    ),
+    Mutant(
+        "welch-moment-halves-swapped",
+        P + "stability/periodic.py",
+        "return q[:-1, 0] + q[1:, 0], q[:-1, 1] + q[1:, 2]",
+        "return q[:-1, 0] + q[1:, 0], q[:-1, 2] + q[1:, 1]",
+        _t("periodic"),
+        "a segment's moment about its centre from the wrong halves of the centred index",
+    ),
+    Mutant(
+        "welch-odd-moment",
+        P + "stability/periodic.py",
+        "both = np.array([[float(row.sum()), float(row @ t)] for row in view])",
+        "both = np.array([[float(row.sum()), float(row @ t[::-1])] for row in view])",
+        _t("periodic"),
+        "an odd segment's moment with the index reversed (the slope's sign flipped)",
+    ),
+    Mutant(
+        "welch-running-median-rank",
+        P + "stability/periodic.py",
+        "        block.partition(half, axis=1)\n        out[a : a + rows] = block[:, half]\n",
+        "        block.partition(half - 1, axis=1)\n        out[a : a + rows] = block[:, half - 1]\n",
+        _t("periodic"),
+        "the floor one rank below the median",
+    ),
+    Mutant(
+        "stuck-levels-first-only",
+        P + "stability/analysis.py",
+        "        rest = rest[rest != first]\n",
+        "        rest = rest[1:]\n",
+        _t("analysis_levels"),
+        "distinct values counted as samples: a column of three levels not warned",
+    ),
+    Mutant(
+        "stuck-minmax-nan-blind",
+        P + "stability/analysis.py",
+        "    if not (math.isfinite(lo) and math.isfinite(hi)):\n",
+        "    if False:\n",
+        _t("analysis_levels"),
+        "a constant column with a NaN not refused (its minimum is NaN)",
+    ),
 )
 
 
