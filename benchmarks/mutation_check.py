@@ -4962,6 +4962,21 @@ MUTANTS: tuple[Mutant, ...] = (
         "    if False:\n",
         _t("analysis_levels"),
         "a constant column with a NaN not refused (its minimum is NaN)",
+    ),    Mutant(
+        "allan-sums-first-difference-x0",
+        P + "stability/allan.py",
+        "            d[0] = x1[mm - 1] - 0.0\n",
+        "            d[0] = x1[mm] - x1[0]\n",
+        _t("allan_sums"),
+        "the first row's difference read from x_1 instead of x_0 = 0",
+    ),
+    Mutant(
+        "allan-sums-second-difference-lag",
+        P + "stability/allan.py",
+        "        np.subtract(d[mm:], d[: b - a], out=t)\n",
+        "        np.subtract(d[mm : mm + b - a], d[1 : b - a + 1] if mm > 1 else d[: b - a], out=t)\n",
+        _t("allan_sums"),
+        "the difference of first differences one row off (m > 1)",
     ),
 )
 
