@@ -70,6 +70,7 @@ from __future__ import annotations
 import dataclasses
 import math
 import os
+from collections.abc import Callable
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 from typing import Any, Final, Literal, cast
@@ -130,7 +131,8 @@ on 10⁷ samples 1 << 16 took 0.82× the CPU time of 1 << 18)."""
 
 _SHORT_M: Final = _CHUNK // 4
 """Averaging factors up to this take the second difference as a difference of first
-differences (two passes a row instead of three, on a block m rows longer)."""
+differences (two passes a row instead of three, on a block m rows longer), block by block
+for all of them at once (:func:`_short_sums`)."""
 
 _THREADED_FROM: Final = 1 << 20
 """Phase points from which the averaging factors are shared between threads."""
@@ -614,7 +616,7 @@ def averaging_factors(taus: TauSpec, tau0_s: float, n_samples: int) -> IntArray:
 
 def _phase(rate: FloatArray, overwrite: bool = False) -> FloatArray:
     """x_k = Σ_{i<k} (y_i − ȳ), in units of rate·τ0, *without* its leading x_0 = 0: the
-    array returned holds x_1 … x_n (one per rate sample; :func:`_second_difference_sum`
+    array returned holds x_1 … x_n (one per rate sample; :func:`second_difference_sums`
     supplies x_0).  With ``overwrite`` (and a writeable ``rate``) it is computed in
     ``rate``'s own buffer: no memory per sample."""
     mean = rate.mean()
@@ -624,37 +626,54 @@ def _phase(rate: FloatArray, overwrite: bool = False) -> FloatArray:
     return x
 
 
-def _second_difference_sum(x1: FloatArray, mm: int) -> float:
-    """S(m) = Σ_k (x_{k+2m} − 2 x_{k+m} + x_k)² for one m, in cache-sized blocks, with
-    ``x1`` = x_1 … x_n (x_0 = 0 is not stored, :func:`_phase`).
+def _short_sums(x1: FloatArray, ms: list[int], blocks: range) -> list[list[float]]:
+    """Per block ``a`` of ``blocks`` (rows a … a + :data:`_CHUNK` of the second
+    difference) and per factor m of ``ms`` (each at most :data:`_SHORT_M`), the block's
+    Σ (d_{k+m} − d_k)² with the first differences ``d_k = x_{k+m} − x_k`` taken over its
+    rows and m more: two passes a row, the block's phase read from memory once for every
+    factor (it stays in the cache between them).  A block beyond a factor's rows gives 0."""
+    n = x1.size
+    top = max(ms)
+    diff = np.empty(_CHUNK + top, dtype=np.float64)
+    out = np.empty(_CHUNK, dtype=np.float64)
+    dots: list[list[float]] = []
+    for a in blocks:
+        row = []
+        for mm in ms:
+            b = min(a + _CHUNK, n + 1 - 2 * mm)
+            if b <= a:
+                row.append(0.0)
+                continue
+            d, t = diff[: b - a + mm], out[: b - a]
+            lo = max(a, 1)  # rows k ≥ 1 read x_k = x1[k − 1]; k = 0 reads x_0 = 0
+            np.subtract(x1[lo + mm - 1 : b + 2 * mm - 1], x1[lo - 1 : b + mm - 1], out=d[lo - a :])
+            if a == 0:  # d_0 = x_m − x_0, x_0 = 0
+                d[0] = x1[mm - 1] - 0.0
+            np.subtract(d[mm:], d[: b - a], out=t)
+            row.append(float(np.dot(t, t)))
+        dots.append(row)
+    return dots
 
-    For m up to a quarter of a block (:data:`_SHORT_M`), each block takes the first
-    differences ``d_k = x_{k+m} − x_k`` over its rows and m more, then ``d_{k+m} − d_k``:
-    two passes a row.  A longer m computes ``x_{k+2m} + x_k − 2·x_{k+m}`` (three passes, no
-    block m rows longer).  Either way one block buffer or two, reused.
-    """
+
+def _added(parts: list[list[list[float]]], ms: list[int], n: int) -> list[float]:
+    """Each factor's block sums (``parts``: :func:`_short_sums` of consecutive block
+    ranges) added in block order from 0.0, as one loop over the blocks adds them."""
+    totals = [0.0] * len(ms)
+    a = 0
+    for part in parts:
+        for row in part:
+            for j, mm in enumerate(ms):
+                if a < n + 1 - 2 * mm:
+                    totals[j] += row[j]
+            a += _CHUNK
+    return totals
+
+
+def _long_sum(x1: FloatArray, mm: int) -> float:
+    """:func:`second_difference_sums` for one m beyond :data:`_SHORT_M`: ``x_{k+2m} + x_k −
+    2·x_{k+m}`` per block into two reused buffers (doubling is exact; three passes a row,
+    no block m rows longer)."""
     n_terms = x1.size + 1 - 2 * mm
-    if mm > _SHORT_M:
-        return _second_difference_sum_long(x1, mm, n_terms)
-    size = min(_CHUNK, max(n_terms, 1))
-    diff = np.empty(size + mm, dtype=np.float64)
-    out = np.empty(size, dtype=np.float64)
-    total = 0.0
-    for a in range(0, n_terms, _CHUNK):
-        b = min(a + _CHUNK, n_terms)
-        d, t = diff[: b - a + mm], out[: b - a]
-        lo = max(a, 1)  # rows k ≥ 1 read x_k = x1[k − 1]; k = 0 reads x_0 = 0
-        np.subtract(x1[lo + mm - 1 : b + 2 * mm - 1], x1[lo - 1 : b + mm - 1], out=d[lo - a :])
-        if a == 0:  # d_0 = x_m − x_0, x_0 = 0
-            d[0] = x1[mm - 1] - 0.0
-        np.subtract(d[mm:], d[: b - a], out=t)
-        total += float(np.dot(t, t))
-    return total
-
-
-def _second_difference_sum_long(x1: FloatArray, mm: int, n_terms: int) -> float:
-    """:func:`_second_difference_sum` for m beyond :data:`_SHORT_M`: ``x_{k+2m} + x_k −
-    2·x_{k+m}`` per block into two reused buffers (doubling is exact)."""
     size = min(_CHUNK, max(n_terms, 1))
     buf = np.empty(size, dtype=np.float64)
     buf2 = np.empty(size, dtype=np.float64)
@@ -675,11 +694,14 @@ def _second_difference_sum_long(x1: FloatArray, mm: int, n_terms: int) -> float:
 
 
 def second_difference_sums(x1: FloatArray, m: IntArray) -> FloatArray:
-    r"""S(m) for each averaging factor m (see :func:`_second_difference_sum`; ``x1`` the
-    phase without x_0).
+    r"""S(m) for each averaging factor m (``x1`` the phase without x_0): the factors up
+    to :data:`_SHORT_M` block by block, each block of the phase read once for all of them
+    (:func:`_short_sums`), the longer ones factor by factor (:func:`_long_sum`).
 
-    The averaging factors are shared between :data:`_WORKERS` threads (numpy releases
-    the GIL inside its loops); BLAS is held to one thread meanwhile, because a
+    The work is shared between :data:`_WORKERS` threads (numpy releases the GIL inside
+    its loops): the short factors' blocks in as many consecutive ranges, the long factors
+    one a task; each factor's block sums are added in block order, so the result does not
+    depend on the threads.  BLAS is held to one thread meanwhile, because a
     multi-threaded ``dot`` inside each worker would oversubscribe the cores.
 
     Parameters
@@ -697,20 +719,33 @@ def second_difference_sums(x1: FloatArray, m: IntArray) -> FloatArray:
     Notes
     -----
     .. math:: S(m) = \sum_{i} (x_{i+2m} - 2x_{i+m} + x_i)^2
+              = \sum_{i} (d_{i+m} - d_i)^2, \quad d_i = x_{i+m} - x_i
 
     References
     ----------
     - NIST SP 1065 (Riley 2008), eq. 11 (overlapping Allan variance from phase).
     """
     ms = [int(v) for v in m.tolist()]
-    workers = min(_WORKERS, len(ms))
+    short = [mm for mm in ms if mm <= _SHORT_M]
+    long = [mm for mm in ms if mm > _SHORT_M]
+    workers = _WORKERS if x1.size >= _THREADED_FROM else 1
+    tasks: list[Callable[[], Any]] = []
+    blocks = range(0, x1.size + 1 - 2 * min(short), _CHUNK) if short else range(0)
+    if blocks:
+        step = -(-len(blocks) // workers)
+        ranges = [blocks[i : i + step] for i in range(0, len(blocks), step)]
+        tasks += [lambda r=r: _short_sums(x1, short, r) for r in ranges]
+    tasks += [lambda mm=mm: _long_sum(x1, mm) for mm in long]
     with threadpool_limits(limits=1, user_api="blas"):
-        if workers <= 1 or x1.size < _THREADED_FROM:
-            vals = [_second_difference_sum(x1, mm) for mm in ms]
+        if workers <= 1 or len(tasks) <= 1:
+            done = [task() for task in tasks]
         else:
             with ThreadPoolExecutor(max_workers=workers) as pool:
-                vals = list(pool.map(lambda mm: _second_difference_sum(x1, mm), ms))
-    return np.asarray(vals, dtype=np.float64)
+                done = list(pool.map(lambda task: task(), tasks))
+    n_short = len(tasks) - len(long)
+    by_m = dict(zip(short, _added(done[:n_short], short, x1.size), strict=True))
+    by_m.update(zip(long, done[n_short:], strict=True))
+    return np.asarray([by_m[mm] for mm in ms], dtype=np.float64)
 
 
 def edf_simple(n_phase: npt.ArrayLike, m: npt.ArrayLike, alpha: npt.ArrayLike) -> FloatArray:
@@ -859,6 +894,7 @@ def overlapping_adev(
     confidence: float = ONE_SIGMA_CONFIDENCE,
     alpha: int | None = None,
     overwrite: bool = False,
+    before_sums: Callable[[], object] | None = None,
 ) -> AllanResult:
     r"""Overlapping Allan deviation of rate data with chi-square intervals.
 
@@ -887,6 +923,9 @@ def overlapping_adev(
     overwrite : bool
         The phase may be accumulated in ``rate``'s own buffer (a writeable float64 array
         the caller no longer needs: its values are destroyed).
+    before_sums : callable, optional
+        Called once the rate is read for the EDF, before the sums (which may overwrite it)
+        start: a caller reading the same buffer in a thread of its own waits there.
 
     Returns
     -------
@@ -931,6 +970,8 @@ def overlapping_adev(
         alphas, methods, edf = family.oadev_edf(
             y, tau0_s, m, segments=[sl for sl in slices if sl.stop - sl.start >= 3], alpha=alpha
         )
+    if before_sums is not None:
+        before_sums()
     sums, n_terms, used, segs, _seg_terms = _pooled_sums(y, slices, m, overwrite)
 
     avar = sums / (2.0 * m.astype(np.float64) ** 2 * n_terms)
