@@ -4943,7 +4943,8 @@ MUTANTS: tuple[Mutant, ...] = (
         "welch-running-median-rank",
         P + "stability/periodic.py",
         "        block.partition(half, axis=1)\n        out[a : a + rows] = block[:, half]\n",
-        "        block.partition(half - 1, axis=1)\n        out[a : a + rows] = block[:, half - 1]\n",
+        "        block.partition(half - 1, axis=1)\n"
+        "        out[a : a + rows] = block[:, half - 1]\n",
         _t("periodic"),
         "the floor one rank below the median",
     ),
@@ -4962,7 +4963,8 @@ MUTANTS: tuple[Mutant, ...] = (
         "    if False:\n",
         _t("analysis_levels"),
         "a constant column with a NaN not refused (its minimum is NaN)",
-    ),    Mutant(
+    ),
+    Mutant(
         "allan-sums-first-difference-x0",
         P + "stability/allan.py",
         "                d[0] = x1[mm - 1] - 0.0\n",
@@ -4974,7 +4976,8 @@ MUTANTS: tuple[Mutant, ...] = (
         "allan-sums-second-difference-lag",
         P + "stability/allan.py",
         "            np.subtract(d[mm:], d[: b - a], out=t)\n",
-        "            np.subtract(d[mm : mm + b - a], d[1 : b - a + 1] if mm > 1 else d[: b - a], out=t)\n",
+        "            np.subtract(d[mm : mm + b - a], d[1 : b - a + 1] if mm > 1 else d[: b - a],"
+        " out=t)\n",
         _t("allan_sums"),
         "the difference of first differences one row off (m > 1)",
     ),

@@ -21,7 +21,7 @@ from thermocal.stability.analysis import check_not_stuck
 def test_constant_with_a_bad_sample_is_refused(bad: float) -> None:
     v = np.full(1000, 2.5)
     v[7] = bad
-    with pytest.raises(ThermocalInputError, match="constant \\(2.5 in all 999 samples\\)"):
+    with pytest.raises(ThermocalInputError, match=r"constant \(2\.5 in all 999 samples\)"):
         check_not_stuck(v, "gx", "f.csv")
 
 

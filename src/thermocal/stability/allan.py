@@ -68,6 +68,7 @@ Frequency Stability Analysis*, NIST SP 1065 (2008); IEEE Std 1554-2005.
 from __future__ import annotations
 
 import dataclasses
+import functools
 import math
 import os
 from collections.abc import Callable
@@ -602,7 +603,7 @@ def averaging_factors(taus: TauSpec, tau0_s: float, n_samples: int) -> IntArray:
         m = np.round(tau / tau0_s)
     m = np.sort(m.astype(np.int64))
     m = m[np.diff(m, prepend=m[:1] - 1) != 0]  # unique (np.unique imports numpy.ma)
-    m = m[(m >= 1) & (m <= m_max)]
+    m = np.asarray(m[(m >= 1) & (m <= m_max)], dtype=np.int64)
     if m.size == 0:
         raise ThermocalInputError(
             f"no averaging time τ fits the data: τ0 = {tau0_s:g} s, at most "
@@ -734,8 +735,8 @@ def second_difference_sums(x1: FloatArray, m: IntArray) -> FloatArray:
     if blocks:
         step = -(-len(blocks) // workers)
         ranges = [blocks[i : i + step] for i in range(0, len(blocks), step)]
-        tasks += [lambda r=r: _short_sums(x1, short, r) for r in ranges]
-    tasks += [lambda mm=mm: _long_sum(x1, mm) for mm in long]
+        tasks += [functools.partial(_short_sums, x1, short, r) for r in ranges]
+    tasks += [functools.partial(_long_sum, x1, mm) for mm in long]
     with threadpool_limits(limits=1, user_api="blas"):
         if workers <= 1 or len(tasks) <= 1:
             done = [task() for task in tasks]
