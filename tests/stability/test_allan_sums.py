@@ -33,3 +33,21 @@ def test_sums_equal_the_direct_formula(n: int, drift: float) -> None:
     m = np.unique(np.array([k for k in cand if 1 <= k <= (n - 1) // 2], dtype=np.int64))
     got = allan.second_difference_sums(allan._phase(y.copy()), m)
     np.testing.assert_allclose(got, _direct(y, m), rtol=1e-12)
+
+
+def test_sums_of_a_smooth_record_keep_their_digits() -> None:
+    """A slowly varying record (a temperature ramp read as a rate): its phase is large
+    against its short-m second differences, so the order of the operations decides the
+    digits.  The sums equal the same float64 phase's sums taken in extended precision
+    (numpy's longdouble, written here) to 1e-12; three taps added at once (main before
+    this test) were 1e-9 off here, 1.6e-5 on the 10⁷-row temperature column of
+    ``bench_allan_cli.py``'s file."""
+    n = 300_000
+    k = np.arange(n, dtype=np.float64)
+    y = 25.0 + 1e-6 * k + 1e-13 * k**2
+    x1 = allan._phase(y.copy())
+    m = np.array([1, 2, 4, 16, 256, allan._SHORT_M], dtype=np.int64)
+    x = np.concatenate([[0.0], x1]).astype(np.longdouble)
+    want = np.array([np.sum((x[2 * j :] - 2 * x[j:-j] + x[: -2 * j]) ** 2) for j in m])
+    got = allan.second_difference_sums(x1, m)
+    np.testing.assert_allclose(got, want.astype(np.float64), rtol=1e-12)
