@@ -133,10 +133,14 @@ on 10⁷ samples 1 << 16 took 0.82× the CPU time of 1 << 18)."""
 _SHORT_M: Final = _CHUNK // 4
 """Averaging factors up to this take the second difference as a difference of first
 differences (two passes a row instead of three, on a block m rows longer), block by block
-for all of them at once (:func:`_short_sums`)."""
+for all of them at once (:func:`_block_sums`)."""
 
 _THREADED_FROM: Final = 1 << 20
-"""Phase points from which the averaging factors are shared between threads."""
+"""Phase points from which the blocks are shared between threads."""
+
+_RANGES_PER_WORKER: Final = 4
+"""Block ranges per thread (the early blocks serve every factor, the late ones the short
+factors only: more ranges than threads even the load)."""
 
 _WORKERS: Final = max(1, min(2, os.cpu_count() or 1))
 """Threads sharing the averaging factors of one Allan computation."""
@@ -627,16 +631,19 @@ def _phase(rate: FloatArray, overwrite: bool = False) -> FloatArray:
     return x
 
 
-def _short_sums(x1: FloatArray, ms: list[int], blocks: range) -> list[list[float]]:
+def _block_sums(x1: FloatArray, ms: list[int], blocks: range) -> list[list[float]]:
     """Per block ``a`` of ``blocks`` (rows a … a + :data:`_CHUNK` of the second
-    difference) and per factor m of ``ms`` (each at most :data:`_SHORT_M`), the block's
-    Σ (d_{k+m} − d_k)² with the first differences ``d_k = x_{k+m} − x_k`` taken over its
-    rows and m more: two passes a row, the block's phase read from memory once for every
-    factor (it stays in the cache between them).  A block beyond a factor's rows gives 0."""
+    difference) and per factor m of ``ms`` (increasing), the block's sum of squared second
+    differences: up to :data:`_SHORT_M` as Σ (d_{k+m} − d_k)² with the first differences
+    ``d_k = x_{k+m} − x_k`` over its rows and m more (two passes a row), beyond as
+    :func:`_long_block`.  The block's phase is read from memory once for every factor, and
+    a factor's farthest tap is the next octave's middle one: both stay in the cache between
+    the factors.  A block beyond a factor's rows gives 0."""
     n = x1.size
-    top = max(ms)
+    top = max([mm for mm in ms if mm <= _SHORT_M], default=0)
     diff = np.empty(_CHUNK + top, dtype=np.float64)
     out = np.empty(_CHUNK, dtype=np.float64)
+    out2 = np.empty(_CHUNK, dtype=np.float64)
     dots: list[list[float]] = []
     for a in blocks:
         row = []
@@ -644,6 +651,9 @@ def _short_sums(x1: FloatArray, ms: list[int], blocks: range) -> list[list[float
             b = min(a + _CHUNK, n + 1 - 2 * mm)
             if b <= a:
                 row.append(0.0)
+                continue
+            if mm > _SHORT_M:
+                row.append(_long_block(x1, mm, a, b, out[: b - a], out2[: b - a]))
                 continue
             d, t = diff[: b - a + mm], out[: b - a]
             lo = max(a, 1)  # rows k ≥ 1 read x_k = x1[k − 1]; k = 0 reads x_0 = 0
@@ -656,8 +666,22 @@ def _short_sums(x1: FloatArray, ms: list[int], blocks: range) -> list[list[float
     return dots
 
 
+def _long_block(x1: FloatArray, mm: int, a: int, b: int, t: FloatArray, t2: FloatArray) -> float:
+    """Σ_{k=a}^{b−1} (x_{k+2m} + x_k − 2·x_{k+m})² for an m beyond :data:`_SHORT_M` (no
+    block m rows longer; doubling is exact), in the buffers ``t``, ``t2`` of b − a rows."""
+    lo = max(a, 1)  # rows k ≥ 1 read x_k = x1[k − 1]; k = 0 reads x_0 = 0
+    r = slice(lo - a, b - a)
+    np.add(x1[lo + 2 * mm - 1 : b + 2 * mm - 1], x1[lo - 1 : b - 1], out=t[r])
+    np.multiply(x1[lo + mm - 1 : b + mm - 1], 2.0, out=t2[r])
+    if a == 0:  # k = 0: x_{2m} + x_0 − 2 x_m, x_0 = 0
+        t[0] = x1[2 * mm - 1] + 0.0
+        t2[0] = x1[mm - 1] * 2.0
+    np.subtract(t, t2, out=t)
+    return float(np.dot(t, t))
+
+
 def _added(parts: list[list[list[float]]], ms: list[int], n: int) -> list[float]:
-    """Each factor's block sums (``parts``: :func:`_short_sums` of consecutive block
+    """Each factor's block sums (``parts``: :func:`_block_sums` of consecutive block
     ranges) added in block order from 0.0, as one loop over the blocks adds them."""
     totals = [0.0] * len(ms)
     a = 0
@@ -670,40 +694,15 @@ def _added(parts: list[list[list[float]]], ms: list[int], n: int) -> list[float]
     return totals
 
 
-def _long_sum(x1: FloatArray, mm: int) -> float:
-    """:func:`second_difference_sums` for one m beyond :data:`_SHORT_M`: ``x_{k+2m} + x_k −
-    2·x_{k+m}`` per block into two reused buffers (doubling is exact; three passes a row,
-    no block m rows longer)."""
-    n_terms = x1.size + 1 - 2 * mm
-    size = min(_CHUNK, max(n_terms, 1))
-    buf = np.empty(size, dtype=np.float64)
-    buf2 = np.empty(size, dtype=np.float64)
-    total = 0.0
-    for a in range(0, n_terms, _CHUNK):
-        b = min(a + _CHUNK, n_terms)
-        t, t2 = buf[: b - a], buf2[: b - a]
-        lo = max(a, 1)  # rows k ≥ 1 read x_k = x1[k − 1]; k = 0 reads x_0 = 0
-        r = slice(lo - a, b - a)
-        np.add(x1[lo + 2 * mm - 1 : b + 2 * mm - 1], x1[lo - 1 : b - 1], out=t[r])
-        np.multiply(x1[lo + mm - 1 : b + mm - 1], 2.0, out=t2[r])
-        if a == 0:  # k = 0: x_{2m} + x_0 − 2 x_m, x_0 = 0
-            t[0] = x1[2 * mm - 1] + 0.0
-            t2[0] = x1[mm - 1] * 2.0
-        np.subtract(t, t2, out=t)
-        total += float(np.dot(t, t))
-    return total
-
-
 def second_difference_sums(x1: FloatArray, m: IntArray) -> FloatArray:
-    r"""S(m) for each averaging factor m (``x1`` the phase without x_0): the factors up
-    to :data:`_SHORT_M` block by block, each block of the phase read once for all of them
-    (:func:`_short_sums`), the longer ones factor by factor (:func:`_long_sum`).
+    r"""S(m) for each averaging factor m (``x1`` the phase without x_0), block by block,
+    each block of the phase read once for all the factors (:func:`_block_sums`): up to
+    :data:`_SHORT_M` as a difference of first differences, beyond with three taps.
 
-    The work is shared between :data:`_WORKERS` threads (numpy releases the GIL inside
-    its loops): the short factors' blocks in as many consecutive ranges, the long factors
-    one a task; each factor's block sums are added in block order, so the result does not
-    depend on the threads.  BLAS is held to one thread meanwhile, because a
-    multi-threaded ``dot`` inside each worker would oversubscribe the cores.
+    The blocks are shared between :data:`_WORKERS` threads (numpy releases the GIL inside
+    its loops) in consecutive ranges; each factor's block sums are added in block order, so
+    the result does not depend on the threads.  BLAS is held to one thread meanwhile,
+    because a multi-threaded ``dot`` inside each worker would oversubscribe the cores.
 
     Parameters
     ----------
@@ -726,27 +725,19 @@ def second_difference_sums(x1: FloatArray, m: IntArray) -> FloatArray:
     ----------
     - NIST SP 1065 (Riley 2008), eq. 11 (overlapping Allan variance from phase).
     """
-    ms = [int(v) for v in m.tolist()]
-    short = [mm for mm in ms if mm <= _SHORT_M]
-    long = [mm for mm in ms if mm > _SHORT_M]
+    ms = sorted({int(v) for v in m.tolist()})
+    blocks = range(0, x1.size + 1 - 2 * ms[0], _CHUNK) if ms else range(0)
     workers = _WORKERS if x1.size >= _THREADED_FROM else 1
-    tasks: list[Callable[[], Any]] = []
-    blocks = range(0, x1.size + 1 - 2 * min(short), _CHUNK) if short else range(0)
-    if blocks:
-        step = -(-len(blocks) // workers)
-        ranges = [blocks[i : i + step] for i in range(0, len(blocks), step)]
-        tasks += [functools.partial(_short_sums, x1, short, r) for r in ranges]
-    tasks += [functools.partial(_long_sum, x1, mm) for mm in long]
+    step = max(1, -(-len(blocks) // (_RANGES_PER_WORKER * workers)))
+    ranges = [blocks[i : i + step] for i in range(0, len(blocks), step)]
     with threadpool_limits(limits=1, user_api="blas"):
-        if workers <= 1 or len(tasks) <= 1:
-            done = [task() for task in tasks]
+        if workers <= 1 or len(ranges) <= 1:
+            parts = [_block_sums(x1, ms, r) for r in ranges]
         else:
             with ThreadPoolExecutor(max_workers=workers) as pool:
-                done = list(pool.map(lambda task: task(), tasks))
-    n_short = len(tasks) - len(long)
-    by_m = dict(zip(short, _added(done[:n_short], short, x1.size), strict=True))
-    by_m.update(zip(long, done[n_short:], strict=True))
-    return np.asarray([by_m[mm] for mm in ms], dtype=np.float64)
+                parts = list(pool.map(functools.partial(_block_sums, x1, ms), ranges))
+    by_m = dict(zip(ms, _added(parts, ms, x1.size), strict=True))
+    return np.asarray([by_m[int(v)] for v in m.tolist()], dtype=np.float64)
 
 
 def edf_simple(n_phase: npt.ArrayLike, m: npt.ArrayLike, alpha: npt.ArrayLike) -> FloatArray:

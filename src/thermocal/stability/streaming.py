@@ -302,7 +302,7 @@ def _second_difference_sum(x1: BlockSource, mm: int, work: _Work) -> float:
     in the blocks and with the arithmetic of
     :func:`thermocal.stability.allan.second_difference_sums`: for m up to
     :data:`thermocal.stability.allan._SHORT_M` the difference of first differences
-    (:func:`thermocal.stability.allan._short_sums`), else three taps; the block sums added
+    (:func:`thermocal.stability.allan._block_sums`), else three taps; the block sums added
     in block order (the same bits as in memory)."""
     if mm > allan._SHORT_M:
         return _long_sum(x1, mm, work)
@@ -333,7 +333,7 @@ def _second_difference_sum(x1: BlockSource, mm: int, work: _Work) -> float:
 
 def _long_sum(x1: BlockSource, mm: int, work: _Work) -> float:
     """:func:`_second_difference_sum` for m beyond :data:`thermocal.stability.allan.
-    _SHORT_M`: ``x_{k+2m} + x_k − 2·x_{k+m}`` (:func:`thermocal.stability.allan._long_sum`)."""
+    _SHORT_M`: ``x_{k+2m} + x_k − 2·x_{k+m}`` (:func:`thermocal.stability.allan._long_block`)."""
     chunk = allan._CHUNK
     n_terms = x1.size + 1 - 2 * mm
     size = min(chunk, max(n_terms, 1))
