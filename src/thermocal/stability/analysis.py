@@ -98,10 +98,13 @@ def check_not_stuck(
     import numpy as np
 
     v = np.asarray(values, dtype=np.float64).ravel()
-    finite = v if math.isfinite(float(v.sum())) else v[np.isfinite(v)]
+    lo, hi = (float(v.min()), float(v.max())) if v.size else (math.nan, math.nan)
+    finite = v  # a NaN makes the minimum NaN, an infinity the minimum or maximum infinite
+    if not (math.isfinite(lo) and math.isfinite(hi)):
+        finite = v[np.isfinite(v)]
+        lo, hi = (float(finite.min()), float(finite.max())) if finite.size else (0.0, 0.0)
     if finite.size < STUCK_MIN_SAMPLES:
         return
-    lo, hi = float(finite.min()), float(finite.max())
     if lo == hi:
         raise ThermocalInputError.naming(
             f"{where}: the column {name!r} is constant ({lo:.6g} in all {finite.size} "
@@ -109,13 +112,13 @@ def check_not_stuck(
             "with {" + parameter + "}, or check the sensor",
             parameter,
         )
-    probe = np.unique(finite[:_LEVEL_PROBE])
-    if probe.size > FEW_LEVELS:
+    probe = _first_levels(finite[:_LEVEL_PROBE], FEW_LEVELS + 1)
+    if len(probe) > FEW_LEVELS:
         return
-    levels = np.unique(finite) if finite.size > _LEVEL_PROBE else probe
-    if levels.size <= FEW_LEVELS:
+    levels = _first_levels(finite, FEW_LEVELS + 1) if finite.size > _LEVEL_PROBE else probe
+    if len(levels) <= FEW_LEVELS:
         warnings.warn(
-            f"{where}: the column {name!r} takes only {levels.size} distinct values in "
+            f"{where}: the column {name!r} takes only {len(levels)} distinct values in "
             f"{finite.size} samples ({', '.join(f'{x:.6g}' for x in levels)}): a stuck or "
             "flat-lined sensor, or an output step far coarser than its noise: "
             + (
@@ -126,6 +129,19 @@ def check_not_stuck(
             ConditioningWarning,
             stacklevel=2,
         )
+
+
+def _first_levels(values: FloatArray, most: int) -> list[float]:
+    """The distinct values of ``values`` (no NaN), sorted, up to ``most`` of them: one pass
+    per value found, none sorting the column (a record of noise stops after ``most``
+    passes; ``np.unique`` would sort it and import ``numpy.ma``)."""
+    found: list[float] = []
+    rest = values
+    while rest.size and len(found) < most:
+        first = rest[0]
+        found.append(float(first))
+        rest = rest[rest != first]
+    return sorted(found)
 
 
 def _tau_range(name: str, tau0_s: float, n_phase: int) -> tuple[float, float, int]:
@@ -592,7 +608,11 @@ def _channel_analysis(
     overwrite: bool,
     where: str,
 ) -> AllanChannel:
-    """:func:`_allan_channel`'s work."""
+    """:func:`_allan_channel`'s work: the periodogram of the periodic-term check in a
+    thread beside the quantisation lattice and the ADEV's noise identification (numpy's
+    FFT and loops release the GIL), joined before the sums may overwrite the samples."""
+    from concurrent.futures import ThreadPoolExecutor
+
     from thermocal.stability import allan
     from thermocal.stability import noise_model as nm
     from thermocal.stability.periodic import periodic_terms
@@ -600,25 +620,28 @@ def _channel_analysis(
     # every figure in the data's own unit (°/s data: ADEV in °/s)
     values, unit = signal_in_data_unit(rec, name)
     check_not_stuck(values, name, where)
-    lattice = nm.lattice_step(values)  # before the ADEV overwrites the values
     segs = rec.segments()
     longest = max(segs, key=lambda sl: sl.stop - sl.start) if segs else slice(None)
-    found = periodic_terms(values[longest], rec.sample_interval_s, unit)
-    res = allan.overlapping_adev(
-        values,
-        rec.sample_interval_s,
-        taus,
-        time_s=rec.time_s,
-        segments=rec.segments(),  # one scan of the time column for every channel
-        unit=unit,
-        confidence=confidence,
-        # the phase is accumulated in the column's own buffer (no memory per sample) only
-        # when the caller gives the recording up and the column is not used again: not
-        # when the channel is named twice or the dynamic ADEV reads the rate after it (it
-        # did, on the floor's numpy/pyarrow, where the buffer is writeable: windows of
-        # phase, found by the floor check)
-        overwrite=overwrite and dynamic_s is None,
-    )
+    with ThreadPoolExecutor(max_workers=1) as pool:
+        periodic = pool.submit(periodic_terms, values[longest], rec.sample_interval_s, unit)
+        lattice = nm.lattice_step(values)  # before the ADEV overwrites the values
+        res = allan.overlapping_adev(
+            values,
+            rec.sample_interval_s,
+            taus,
+            time_s=rec.time_s,
+            segments=rec.segments(),  # one scan of the time column for every channel
+            unit=unit,
+            confidence=confidence,
+            # the phase is accumulated in the column's own buffer (no memory per sample)
+            # only when the caller gives the recording up and the column is not used
+            # again: not when the channel is named twice or the dynamic ADEV reads the rate
+            # after it (it did, on the floor's numpy/pyarrow, where the buffer is
+            # writeable: windows of phase, found by the floor check)
+            overwrite=overwrite and dynamic_s is None,
+            before_sums=periodic.result,  # the periodogram has read the samples
+        )
+        found = periodic.result()
     noise = allan.noise_terms(res, periodic=found)
     quant = nm.quantization_from_lattice(lattice, rec.sample_interval_s, unit, noise)
     noise = nm.annotate_quantization(noise, quant)

@@ -299,7 +299,41 @@ def _phase_store(
 
 def _second_difference_sum(x1: BlockSource, mm: int, work: _Work) -> float:
     """S(m) = Σ_k (x_{k+2m} − 2x_{k+m} + x_k)² over a phase store (x_0 = 0 not stored),
-    in the blocks of :func:`thermocal.stability.allan._second_difference_sum`."""
+    in the blocks and with the arithmetic of
+    :func:`thermocal.stability.allan.second_difference_sums`: for m up to
+    :data:`thermocal.stability.allan._SHORT_M` the difference of first differences
+    (:func:`thermocal.stability.allan._block_sums`), else three taps; the block sums added
+    in block order (the same bits as in memory)."""
+    if mm > allan._SHORT_M:
+        return _long_sum(x1, mm, work)
+    chunk = allan._CHUNK
+    n_terms = x1.size + 1 - 2 * mm
+    size = min(chunk, max(n_terms, 1))
+    diff = np.empty(size + mm, dtype=np.float64)
+    out = np.empty(size, dtype=np.float64)
+    total = 0.0
+    for wa in range(0, n_terms, WINDOW):
+        work.check()
+        wb = min(wa + WINDOW, n_terms)
+        lo_w = max(wa, 1) - 1  # x1 index of the first x_k read (k ≥ 1)
+        span = x1.read(lo_w, wb - 1 + 2 * mm)
+        for a in range(wa, wb, chunk):
+            b = min(a + chunk, wb)
+            d, t = diff[: b - a + mm], out[: b - a]
+            lo = max(a, 1)
+            i0, i1 = lo - 1 - lo_w, b + mm - 1 - lo_w
+            np.subtract(span[i0 + mm : i1 + mm], span[i0:i1], out=d[lo - a :])
+            if a == 0:  # d_0 = x_m − x_0, x_0 = 0
+                d[0] = float(span[mm - 1]) - 0.0
+            np.subtract(d[mm:], d[: b - a], out=t)
+            total += float(np.dot(t, t))
+        work.advance(3 * (wb - wa))
+    return total
+
+
+def _long_sum(x1: BlockSource, mm: int, work: _Work) -> float:
+    """:func:`_second_difference_sum` for m beyond :data:`thermocal.stability.allan.
+    _SHORT_M`: ``x_{k+2m} + x_k − 2·x_{k+m}`` (:func:`thermocal.stability.allan._long_block`)."""
     chunk = allan._CHUNK
     n_terms = x1.size + 1 - 2 * mm
     size = min(chunk, max(n_terms, 1))
