@@ -4788,9 +4788,9 @@ MUTANTS: tuple[Mutant, ...] = (
     Mutant(
         "hyst-lag-loop-previous-reading",
         P + "models/hyst_lag.py",
-        "zk = ek * zk + (1.0 - ck) * xs[k] + (ck - ek) * xs[k - 1]",
-        "zk = ek * zk + (1.0 - ck) * xs[k] + (ck - ek) * xs[k]",
-        _t("hyst"),
+        "np.subtract(x1, x[:m].reshape(nb, bsz).T, out=scratch)",
+        "np.subtract(x1, x[1 : m + 1].reshape(nb, bsz).T, out=scratch)",
+        _t("hyst", "hyst_lag"),
         "the irregular-step lag with the current reading for the previous one",
     ),
     Mutant(
@@ -4905,6 +4905,38 @@ MUTANTS: tuple[Mutant, ...] = (
         'f"            jac[j][j] += 1.0 * {p}_K2[j] * u / {p}_G;",',
         _t("export_c_triads_k2"),
         "the C's Newton step with half the derivative: C ≠ Python",
+    ),
+    Mutant(
+        "hyst-scan-no-chaining",
+        P + "models/hyst_lag.py",
+        "np.multiply(q[:, 1:], ends[:-1], out=q[:, 1:])",
+        "np.multiply(q[:, 1:], 0.0, out=q[:, 1:])",
+        _t("hyst_lag"),
+        "the blocked scan's blocks each started from zero: the lag forgets every 32 samples",
+    ),
+    Mutant(
+        "hyst-scan-tail-restart",
+        P + "models/hyst_lag.py",
+        "        g_end = float(w[-1, -1])\n",
+        "        g_end = 0.0\n",
+        _t("hyst_lag"),
+        "the steps after the last whole block continued from zero lag",
+    ),
+    Mutant(
+        "hyst-scan-held-steps",
+        P + "models/hyst_lag.py",
+        "            np.copyto(w, 1.0, where=bad)",
+        "            np.copyto(w, 0.0, where=bad)",
+        _t("hyst_lag"),
+        "a repeated or backward time stamp drops the reading's change instead of holding z",
+    ),
+    Mutant(
+        "hyst-scan-block-products",
+        P + "models/hyst_lag.py",
+        "        np.multiply(a[j], q[j - 1], out=q[j])",
+        "        np.multiply(a[j], q[j - 1] * 0.0 + 1.0, out=q[j])",
+        _t("hyst_lag"),
+        "a block's carried start multiplied by the last step's coefficient only",
     ),
 )
 
