@@ -4917,7 +4917,7 @@ MUTANTS: tuple[Mutant, ...] = (
     Mutant(
         "hyst-scan-tail-restart",
         P + "models/hyst_lag.py",
-        "        g_end = float(w[-1, -1])\n",
+        "        g_end = float(v[-1, -1])\n",
         "        g_end = 0.0\n",
         _t("hyst_lag"),
         "the steps after the last whole block continued from zero lag",
@@ -4925,8 +4925,8 @@ MUTANTS: tuple[Mutant, ...] = (
     Mutant(
         "hyst-scan-held-steps",
         P + "models/hyst_lag.py",
-        "            np.copyto(w, 1.0, where=bad)",
-        "            np.copyto(w, 0.0, where=bad)",
+        "            np.copyto(v, 1.0, where=bad)",
+        "            np.copyto(v, 0.0, where=bad)",
         _t("hyst_lag"),
         "a repeated or backward time stamp drops the reading's change instead of holding z",
     ),

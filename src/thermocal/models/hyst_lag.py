@@ -237,21 +237,21 @@ def _lag_scan(t: FloatArray, x: FloatArray, tau_s: float) -> FloatArray:
         scratch = z[:m].reshape(bsz, nb)
         x1 = x[1 : m + 1].reshape(nb, bsz).T
         np.subtract(x1, x[:m].reshape(nb, bsz).T, out=scratch)  # T_k − T_{k−1}
-        e = np.subtract(t[1 : m + 1].reshape(nb, bsz).T, t[:m].reshape(nb, bsz).T,
+        v = np.subtract(t[1 : m + 1].reshape(nb, bsz).T, t[:m].reshape(nb, bsz).T,
                         out=np.empty((bsz, nb)))  # fmt: skip
-        bad = None if float(e.min()) > 0 else ~(e > 0)
-        np.divide(e, -tau_s, out=e)  # −h/τ
-        w = np.expm1(e)
+        bad = None if float(v.min()) > 0 else ~(v > 0)
+        np.divide(v, -tau_s, out=v)  # −h/τ
+        e = np.expm1(v)
         with np.errstate(invalid="ignore", divide="ignore"):
-            np.divide(w, e, out=w)  # c
-        np.exp(e, out=e)
+            np.divide(e, v, out=v)  # c
+        e += 1.0  # e^(−h/τ) to 1e-16 absolute (the loop's exp: to 1e-16 relative)
         if bad is not None:
             np.copyto(e, 1.0, where=bad)
-            np.copyto(w, 1.0, where=bad)
-        w *= scratch  # c (T_k − T_{k−1})
-        _scan_rows(e, w, scratch)
-        np.subtract(x1.T, w.T, out=z[1 : m + 1].reshape(nb, bsz))
-        g_end = float(w[-1, -1])
+            np.copyto(v, 1.0, where=bad)
+        v *= scratch  # c (T_k − T_{k−1})
+        _scan_rows(e, v, scratch)
+        np.subtract(x1.T, v.T, out=z[1 : m + 1].reshape(nb, bsz))
+        g_end = float(v[-1, -1])
     z[0] = x[0]
     e_t, c_t = lag_coefficients(t[m + 1 :] - t[m:-1], tau_s)
     for k, (ek, ck) in enumerate(zip(e_t.tolist(), c_t.tolist(), strict=True), m + 1):
