@@ -4938,6 +4938,14 @@ MUTANTS: tuple[Mutant, ...] = (
         _t("hyst_lag"),
         "a block's carried start multiplied by the last step's coefficient only",
     ),
+    Mutant(
+        "hyst-rss-horner-sign",
+        P + "models/hyst_lag.py",
+        "        resid += float(c)\n",
+        "        resid -= float(c)\n",
+        _t("hyst_lag"),
+        "the search's polynomial evaluated with the lower coefficients' signs flipped",
+    ),
 )
 
 

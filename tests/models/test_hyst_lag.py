@@ -15,7 +15,10 @@ from thermocal.models.hyst_lag import SCAN_BLOCK, affine_scan, first_order_lag
 
 def _loop(t: np.ndarray, x: np.ndarray, tau: float) -> np.ndarray:
     """z_k = e_k z_{k−1} + (1 − c_k) T_k + (c_k − e_k) T_{k−1}, e_k = exp(−h_k/τ),
-    c_k = (τ/h_k)(1 − e_k); e = c = 1 where h_k ≤ 0 (z held) — sample by sample."""
+    c_k = (τ/h_k)(1 − e_k); e = c = 1 where h_k ≤ 0 (z held) — sample by sample; τ = 0:
+    z = T."""
+    if tau <= 0:
+        return np.array(x, dtype=np.float64)
     z = [float(x[0])]
     for k in range(1, t.size):
         h = float(t[k] - t[k - 1])
@@ -90,3 +93,22 @@ def test_affine_scan_is_its_recursion(n: int) -> None:
     y = affine_scan(a, v)
     assert y.shape == (n,)
     assert np.allclose(y, ref, rtol=1e-13, atol=1e-13)
+
+
+@pytest.mark.parametrize("order", [1, 2, 3])
+def test_the_search_objective_is_the_least_squares_rss(order: int) -> None:
+    """rss_at (power sums, no design matrix) against the RSS of a least squares on the
+    Vandermonde matrix of the test loop's lag, two runs, fitted and misfitted lags."""
+    from thermocal.models.hyst_lag import rss_at
+
+    rng = np.random.default_rng(order)
+    runs = [_record(3001, seed=11), _record(2000, seed=12)]
+    times, temps = [r[0] for r in runs], [r[1] for r in runs]
+    z_true = np.concatenate([_loop(t, x, 120.0) for t, x in runs])
+    y = 0.3 * (z_true - 25.0) - 0.004 * (z_true - 25.0) ** 2 + 0.05 * rng.standard_normal(5001)
+    for tau in (0.0, 40.0, 120.0, 900.0):
+        z = np.concatenate([_loop(t, x, tau) for t, x in runs])
+        v = np.vander((z - 25.0) / 30.0, order + 1)
+        resid = y - v @ np.linalg.lstsq(v, y, rcond=None)[0]
+        ref = float(resid @ resid)
+        assert rss_at(times, temps, y, tau, order, (25.0, 30.0)) == pytest.approx(ref, rel=1e-10)
