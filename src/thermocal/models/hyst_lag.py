@@ -366,6 +366,7 @@ def rss_at(
     tau_s: float,
     order: int,
     centre_scale: tuple[float, float],
+    work: FloatArray | None = None,
 ) -> float:
     r"""The residual sum of squares of :func:`fit_at` at one τ, without the design matrix
     (the lag search's objective).
@@ -382,6 +383,9 @@ def rss_at(
         Polynomial order p.
     centre_scale : tuple of float
         μ and s [°C] of the scaled variable.
+    work : numpy.ndarray, optional
+        Scratch, shape ``(2, y.size)``, reused from call to call (fresh memory costs more
+        than the sums on a large record).
 
     Returns
     -------
@@ -406,22 +410,25 @@ def rss_at(
     u = lagged_runs(times, temps, tau_s)
     u -= mu
     u /= s
-    power = np.ones_like(u)
+    power, prod = np.empty((2, u.size)) if work is None else work
+    np.copyto(power, u)
     sums = [float(u.size)]
     yu = [float(y.sum())]
-    for k in range(1, 2 * order + 1):
-        power *= u
+    for k in range(1, 2 * order + 1):  # numpy's pairwise sums: no BLAS threads spinning
+        if k > 1:
+            power *= u
         sums.append(float(power.sum()))
         if k <= order:
-            yu.append(float(y @ power))
+            yu.append(float(np.multiply(y, power, out=prod).sum()))
     gram = np.array([[sums[j + k] for k in range(order + 1)] for j in range(order + 1)])
     coef = np.linalg.lstsq(gram, np.array(yu), rcond=None)[0]
-    resid = np.full_like(u, float(coef[-1]))
+    resid = power
+    resid.fill(float(coef[-1]))
     for c in coef[-2::-1]:  # Horner
         resid *= u
         resid += float(c)
     np.subtract(y, resid, out=resid)
-    return float(resid @ resid)
+    return float(np.multiply(resid, resid, out=resid).sum())
 
 
 def _lag1(r: FloatArray) -> float:
@@ -517,8 +524,10 @@ def search_tau(
     - R. P. Brent, *Algorithms for Minimization without Derivatives*, Prentice-Hall, 1973.
     """
 
+    work = np.empty((2, y.size))
+
     def rss(tau: float) -> float:
-        return rss_at(times, temps, y, tau, order, centre_scale)
+        return rss_at(times, temps, y, tau, order, centre_scale, work)
 
     lo, hi = bounds_s
     grid = np.concatenate([[0.0], np.geomspace(lo, hi, GRID_POINTS)])
