@@ -575,7 +575,10 @@ def compare_legs(
 
     disagreement when :math:`|t| > t_{1-(1-0.99)/2,\,m-1}` (Student 1908).  The bins are
     treated as independent: slow noise (flicker) shared by neighbouring bins makes the
-    test somewhat liberal.
+    test liberal (16 % rejected at 1 % under AR(1) noise of 300 s on a 1 °C/min sweep); an
+    effective-sample-size correction from the bins' lag-1 autocorrelation, measured in
+    ``benchmarks/bench_legs_test_size.py``, also hides a real, smooth hysteresis and is
+    not applied.
 
     References
     ----------

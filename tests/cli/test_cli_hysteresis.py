@@ -124,3 +124,38 @@ def test_an_isothermal_record_validates_and_says_it_has_no_leg(capsys, tmp_path:
     assert legs["reason"] == "no heating leg"
     code, so, _ = _run(capsys, ["inspect", str(iso), "--json"])
     assert json.loads(so)["legs"]["T1"]["summary"].startswith("no heating or cooling leg")
+
+
+def test_validate_legs_prints_every_channel_of_a_calibration(capsys, tmp_path: Path) -> None:
+    """Two channels with opposite hysteresis (the second the first negated, its own noise):
+    each channel's legs table and heating-vs-cooling line in the text, the same figures as
+    the JSON's."""
+    import pandas as pd
+
+    rec, _ = SCENARIOS["thermal-lag"](3, quant_c=0.0625)[0]
+    write_recording(rec, tmp_path / "one.csv")
+    df = pd.read_csv(tmp_path / "one.csv")
+    df["gyro_b"] = -df["gyro"] + np.random.default_rng(9).normal(0.0, NOISE, len(df))
+    df.to_csv(tmp_path / "two.csv", index=False)
+    code, _, se = _run(capsys, ["fit", str(tmp_path / "two.csv"), "--signal", "gyro,gyro_b",
+                                "--temps", "T1", "--signal-unit", "deg/h", "--model", "poly",
+                                "--order", "3", "--legs", "heating",
+                                "-o", str(tmp_path / "cal.json")])  # fmt: skip
+    assert code == 0, se
+    args = ["validate", str(tmp_path / "cal.json"), str(tmp_path / "two.csv")]
+    code, so, se = _run(capsys, [*args, "--json"])
+    assert code == 0, se
+    legs = {name: ch["legs"] for name, ch in json.loads(so)["channels"].items()}
+    # the poly's heating-leg fit leaves −10.5 °/h (2 °/h/°C × 5 °C of lag) on the first, +10.5
+    assert legs["gyro"]["mean_difference"] == pytest.approx(-10.5, abs=1.0)
+    assert legs["gyro_b"]["mean_difference"] == pytest.approx(10.5, abs=1.0)
+    code, so, se = _run(capsys, [*args, "--legs"])
+    assert code == 0, se
+    for name in ("gyro", "gyro_b"):
+        assert f"{name}: legs: 1 heating and 1 cooling legs" in so
+        assert f"{name}: legs after compensation" in so
+        after = next(ln for ln in so.splitlines() if ln.startswith(f"{name}: after: "))
+        assert "DISAGREE beyond the noise" in after
+        assert f"mean difference {legs[name]['mean_difference']:.4g} deg/h" in after
+    code, so, _ = _run(capsys, args)
+    assert "heating vs cooling" not in so

@@ -98,8 +98,9 @@ LegsReportOpt = Annotated[
         "--legs",
         help="Print each heating and cooling leg of the ambient temperature with the "
         "compensated output's rms, largest error and mean on it, and whether heating and "
-        "cooling disagree at equal temperature beyond the noise (thermal hysteresis); "
-        "the JSON output holds them in any case.",
+        "cooling disagree at equal temperature beyond the noise (thermal hysteresis), for "
+        "every channel of a calibration (each line led by the channel's name); the JSON "
+        "output holds them in any case.",
     ),
 ]
 SettleOpt = Annotated[
@@ -107,8 +108,9 @@ SettleOpt = Annotated[
 ]
 
 
-def _human_channels(report: "_validate.ValidationReport") -> None:
-    """Several channels: one row and one verdict per channel."""
+def _human_channels(report: "_validate.ValidationReport", legs: bool = False) -> None:
+    """Several channels: one row and one verdict per channel; with ``legs`` each channel's
+    heating and cooling legs after the table, channel by channel."""
     per = report.channels
     table = _rich_table.Table(title=f"validation on {report.file}, {len(per)} channels")
     for col in ("channel", "r", "bias stability before → after", "rms before → after",
@@ -128,6 +130,9 @@ def _human_channels(report: "_validate.ValidationReport") -> None:
             res.verdict_line,
         )
     stdout.print(table)
+    if legs:
+        for ch in per:
+            _human_legs(ch.result, ch.name)
 
 
 def _human_single(report: "_validate.ValidationReport", legs: bool = False) -> None:
@@ -180,14 +185,18 @@ def _human_single(report: "_validate.ValidationReport", legs: bool = False) -> N
     stdout.print(f"verdict: {res.verdict_line}")
 
 
-def _human_legs(res: "_validation.ValidationResult") -> None:
+def _human_legs(res: "_validation.ValidationResult", channel: str | None = None) -> None:
     """The heating and cooling legs: each leg's figures after compensation, and whether
-    heating and cooling disagree beyond the noise, before and after."""
+    heating and cooling disagree beyond the noise, before and after; ``channel``: the
+    channel's name before each line (a calibration of several)."""
     if res.legs is None or res.legs_after is None:
         return
-    stdout.print(f"legs: {res.legs.summary()}")
+    who = "" if channel is None else f"{channel}: "
+    stdout.print(f"{who}legs: {res.legs.summary()}")
     if res.legs_after.per_leg:
-        table = _rich_table.Table(title=f"legs after compensation [{res.unit}], about the mean")
+        table = _rich_table.Table(
+            title=f"{who}legs after compensation [{res.unit}], about the mean"
+        )
         for col in ("leg", "time [s]", "T [°C]", "rate [°C/min]", "rms", "max |e|", "mean"):
             table.add_column(col)
         for f in res.legs_after.per_leg:
@@ -203,8 +212,8 @@ def _human_legs(res: "_validation.ValidationResult") -> None:
             )
         stdout.print(table)
     if res.legs_before is not None and res.legs_before.mean_difference is not None:
-        stdout.print(f"before: {res.legs_before.line()}")
-    stdout.print(f"after: {res.legs_after.line()}")
+        stdout.print(f"{who}before: {res.legs_before.line()}")
+    stdout.print(f"{who}after: {res.legs_after.line()}")
 
 
 def _human_triads(report: "_validate.ValidationReport") -> None:
@@ -269,6 +278,6 @@ def validate_cmd(
     if report.triads:
         emit(report.to_dict(), as_json, lambda: _human_triads(report))
     elif report.several:
-        emit(report.to_dict(), as_json, lambda: _human_channels(report))
+        emit(report.to_dict(), as_json, lambda: _human_channels(report, legs))
     else:
         emit(report.to_dict(), as_json, lambda: _human_single(report, legs))
