@@ -4906,6 +4906,46 @@ MUTANTS: tuple[Mutant, ...] = (
         _t("export_c_triads_k2"),
         "the C's Newton step with half the derivative: C ≠ Python",
     ),
+    Mutant(
+        "heater-window-lattice-down",
+        P + "heater.py",
+        "        i -= s\n",
+        "        pass\n",
+        _t("heater"),
+        "a sample just below an edge counted in the window above it (the lattice's rounding)",
+    ),
+    Mutant(
+        "heater-window-lattice-up",
+        P + "heater.py",
+        "        i += s\n",
+        "        pass\n",
+        _t("heater"),
+        "a sample on an edge counted in the window below it (the lattice's rounding)",
+    ),
+    Mutant(
+        "heater-window-last-open",
+        P + "heater.py",
+        "        s &= i < m - 1\n",
+        "",
+        _t("heater"),
+        "the last window open: a sample on the top edge counted nowhere (index out of range)",
+    ),
+    Mutant(
+        "heater-window-outside-kept",
+        P + "heater.py",
+        "    if not inside.all():\n        temp_c, weights = temp_c[inside], weights[inside]\n",
+        "",
+        _t("heater"),
+        "samples outside the edges counted in the end windows",
+    ),
+    Mutant(
+        "heater-window-block-weights",
+        P + "heater.py",
+        "weights=weights[a : a + WINDOW_BLOCK]",
+        "weights=weights[: x.size]",
+        _t("heater"),
+        "every block weighted with the first block's sample times",
+    ),
 )
 
 
