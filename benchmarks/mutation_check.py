@@ -4946,6 +4946,30 @@ MUTANTS: tuple[Mutant, ...] = (
         _t("heater"),
         "every block weighted with the first block's sample times",
     ),
+    Mutant(
+        "fleet-threads-unlimited",
+        P + "fleet/batch.py",
+        "        _one_thread(),\n",
+        "        contextlib.nullcontext(),\n",
+        _t("fleet_reads_once"),
+        "a unit's BLAS/OpenMP pools on every core while the other workers' units run",
+    ),
+    Mutant(
+        "fleet-threads-not-restored",
+        P + "fleet/batch.py",
+        "    return _THREADPOOLS[0][1].limit(limits=1)\n",
+        "    _THREADPOOLS[0][1].limit(limits=1)\n    return contextlib.nullcontext()\n",
+        _t("fleet_reads_once"),
+        "the process's thread pools left at one thread after the batch",
+    ),
+    Mutant(
+        "fleet-report-not-escaped",
+        P + "fleet/report.py",
+        '        autoescape=jinja2.select_autoescape(["html", "j2"]),\n',
+        "        autoescape=False,\n",
+        _t("fleet_attacks"),
+        "a file's or a column's name pasted into fleet.html as markup",
+    ),
 )
 
 
