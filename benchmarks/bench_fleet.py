@@ -159,15 +159,16 @@ def main() -> int:
     ap = argparse.ArgumentParser()
     ap.add_argument("--units", type=int, default=200)
     ap.add_argument("--rows", type=int, default=100_000)
-    ap.add_argument("--quick", action="store_true", help="60 units, best of 2")
-    ap.add_argument("--repeat", type=int, default=3, help="interleaved rounds (best of)")
+    ap.add_argument("--quick", action="store_true", help="60 units")
+    ap.add_argument("--repeat", type=int, help="interleaved rounds (best of; default 3, quick 2)")
     ap.add_argument("--before", metavar="SRC", help="also the fleet of the package in SRC")
     ap.add_argument("--skip-big", action="store_true", help="skip 20 units × 10⁷ samples")
     ap.add_argument(
         "--no-bytecode", action="store_true", help="each process compiles what it imports"
     )
     args = ap.parse_args()
-    units, repeat = (60, 2) if args.quick else (args.units, args.repeat)
+    units, repeat = (60, 2) if args.quick else (args.units, 3)
+    repeat = args.repeat or repeat
     print(f"load average {os.getloadavg()[0]:.2f}, {os.cpu_count()} cores")
     if not args.no_bytecode:  # as an installed package is (PYTHONDONTWRITEBYTECODE is set here)
         import thermocal

@@ -261,8 +261,8 @@ def test_the_plateau_search_bins_every_sample_as_numpy_histogram(step: float) ->
     """The time per temperature window (the search for an inferred set-point) is summed
     without a sort, a block at a time: each sample in the window ``np.histogram`` gives it
     against the same edges — samples exactly on an edge, one unit in the last place either
-    side of one, on the last (closed) edge, outside the edges, a record of several blocks and a partial one — and the same time per window
-    to rounding."""
+    side of one, on the last (closed) edge, outside the edges, a record of several blocks
+    and a partial one — and the same time per window to rounding."""
     from thermocal.heater import WINDOW_BLOCK, _window_time
 
     rng = np.random.default_rng(11)
