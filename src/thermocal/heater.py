@@ -294,6 +294,49 @@ MAX_WINDOWS = 100_000
 temperature spanning more is a damaged record, and no set-point is inferred from it."""
 
 
+WINDOW_BLOCK = 8192
+"""Samples binned at a time by :func:`_window_time`: its scratch arrays (64 kB each) are
+reused block after block instead of a record-long array each (fresh pages are what the
+binning of a long record costs most)."""
+
+
+def _window_time(temp_c: FloatArray, weights: FloatArray, edges: FloatArray) -> FloatArray:
+    r"""The time spent in each temperature window: ``np.histogram(temp_c, bins=edges,
+    weights=weights)[0]`` without its sort, for equally spaced ``edges`` [s].
+
+    A sample's window is first estimated on the lattice, :math:`i = \lfloor (T - e_0)/h
+    \rfloor` (at most :math:`m - 1`) with :math:`h = (e_m - e_0)/m`, then corrected by one
+    step against the edges themselves (:math:`e_i \le T < e_{i+1}`, the last window
+    closed), so that every sample falls in the window ``np.histogram`` gives it; the
+    weights are summed per window by ``np.bincount``, :data:`WINDOW_BLOCK` samples at a
+    time (no sort: ``np.histogram`` with explicit edges sorts the samples and differences
+    a cumulative sum; the same sums to rounding).  Samples outside ``[e_0, e_m]`` are left
+    out, as ``np.histogram`` leaves them.
+    """
+    m = edges.size - 1
+    inside = (temp_c >= edges[0]) & (temp_c <= edges[-1])
+    if not inside.all():
+        temp_c, weights = temp_c[inside], weights[inside]
+    scale = m / (edges[-1] - edges[0])
+    out = np.zeros(m)
+    k = min(WINDOW_BLOCK, temp_c.size)
+    pos, idx, step = np.empty(k), np.empty(k, dtype=np.intp), np.empty(k, dtype=bool)
+    for a in range(0, temp_c.size, WINDOW_BLOCK):
+        x = temp_c[a : a + WINDOW_BLOCK]
+        p, i, s = pos[: x.size], idx[: x.size], step[: x.size]
+        np.subtract(x, edges[0], out=p)
+        p *= scale
+        i[...] = p  # truncation is the floor here: p >= 0
+        np.minimum(i, m - 1, out=i)
+        np.less(x, np.take(edges, i, out=p), out=s)  # the lattice's rounding: edges decide
+        i -= s
+        np.greater_equal(x, np.take(edges[1:], i, out=p), out=s)
+        s &= i < m - 1
+        i += s
+        out += np.bincount(i, weights=weights[a : a + WINDOW_BLOCK], minlength=m)
+    return out
+
+
 def _infer_setpoint(
     time_s: FloatArray, temp_c: FloatArray, band_c: float, min_hold_s: float
 ) -> float | None:
@@ -314,7 +357,7 @@ def _infer_setpoint(
     edges = np.arange(lo, hi + 2 * band_c, band_c)
     if edges.size < 3:
         return None
-    spent, _ = np.histogram(temp_c, bins=edges, weights=dt)
+    spent = _window_time(temp_c, dt, edges)
     pair = spent[:-1] + spent[1:]
     k = int(np.argmax(pair))
     inside = (temp_c >= edges[k]) & (temp_c <= edges[k + 2])
@@ -333,7 +376,7 @@ def _infer_setpoint(
     if not out.any() or float(np.ptp(temp_c[out])) < MIN_INFERRED_SWEEP_C:
         return None  # a plateau with no sweep to speak of: a warm-up, a hold, no heater
     far = out & (np.abs(temp_c - level) > 2 * band_c)
-    rest, _ = np.histogram(temp_c[far], bins=edges, weights=dt[far])
+    rest = _window_time(temp_c[far], dt[far], edges)
     held_s = float(time_s[run[1]] - time_s[run[0]])
     if rest.size > 1 and float(np.max(rest[:-1] + rest[1:])) >= max(min_hold_s, held_s / 4):
         return None

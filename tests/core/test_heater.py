@@ -254,3 +254,30 @@ def test_a_heater_hold_at_the_top_is_no_cold_cut() -> None:
     tr = heated_truth(0)
     hold = find_heater_hold(tr["time_s"], tr["temp"], setpoint_c=55.0)
     assert hold is not None and hold.range_cut and not hold.cold_cut
+
+
+@pytest.mark.parametrize("step", [0.5, 0.0625, 0.1])
+def test_the_plateau_search_bins_every_sample_as_numpy_histogram(step: float) -> None:
+    """The time per temperature window (the search for an inferred set-point) is summed
+    without a sort, a block at a time: each sample in the window ``np.histogram`` gives it
+    against the same edges — samples exactly on an edge, one unit in the last place either
+    side of one, on the last (closed) edge, outside the edges, a record of several blocks
+    and a partial one — and the same time per window to rounding."""
+    from thermocal.heater import WINDOW_BLOCK, _window_time
+
+    rng = np.random.default_rng(11)
+    n = 2 * WINDOW_BLOCK + 123
+    temp = np.round(rng.uniform(-10.0, 60.0, n) / step) * step  # a thermometer's lattice
+    temp[::7] += rng.uniform(-step, step, temp[::7].size)  # and readings between
+    lo, hi = float(temp.min()), float(temp.max())
+    edges = np.arange(lo, hi + 2 * step, step)  # as the search makes them
+    temp[:50] = edges[rng.integers(0, edges.size, 50)]  # exactly on edges, the last included
+    temp[50], temp[51] = edges[-1], lo - 1.0  # the closed last edge; a sample outside
+    near = edges[rng.integers(1, edges.size - 1, 400)]  # one unit in the last place off
+    temp[52:452] = np.nextafter(near, np.where(np.arange(400) % 2, np.inf, -np.inf))
+    weights = rng.uniform(0.05, 0.15, n)
+    counted = _window_time(temp, np.ones(n), edges)
+    np.testing.assert_array_equal(counted, np.histogram(temp, bins=edges)[0])
+    spent = _window_time(temp, weights, edges)
+    want = np.histogram(temp, bins=edges, weights=weights)[0]
+    np.testing.assert_allclose(spent, want, rtol=1e-12, atol=1e-12 * weights.sum())

@@ -332,3 +332,27 @@ def test_a_stale_unit_is_redone_and_never_reported_ok(
     assert coefs["T1"] == pytest.approx(slope, rel=1e-7)
     assert rec["status"] == "ok" and rec["redone_because"] == res["redone"]["U1"]
     shutil.rmtree(out)
+
+
+def test_names_in_the_report_are_text_not_markup(tmp_path: Path) -> None:
+    """A file name or a column name is the user's text: in ``fleet.html`` it is escaped
+    (the error naming a missing file ``<img src=x onerror=alert(1)>.csv``, a channel whose
+    column is named with markup), never markup the browser runs."""
+    import pandas as pd
+
+    data = _data(tmp_path)
+    frame = pd.read_csv(data)
+    frame = frame.rename(columns={"gx [deg/s]": "gx <b>x</b> [deg/s]"})
+    frame[["time [s]", "gx <b>x</b> [deg/s]", "T1 [degC]"]].to_csv(data, index=False)
+    bad = "<img src=x onerror=alert(1)>.csv"
+    cfg = tmp_path / "batch.toml"
+    cfg.write_text(
+        '[fit]\nmodel = "poly"\norder = 1\nsignal = "gx <b>x</b> [deg/s]"\n'
+        'temps = "T1 [degC]"\n\n[[unit]]\nid = "U1"\nmodeling = ["data/U1.csv"]\n\n'
+        f'[[unit]]\nid = "U2"\nmodeling = ["data/{bad}"]\n',
+        encoding="utf-8",
+    )
+    main(["fleet", str(cfg), "-o", str(tmp_path / "out"), "--workers", "1", "--json"])
+    html = (tmp_path / "out" / "fleet.html").read_text(encoding="utf-8")
+    assert "gx &lt;b&gt;x&lt;/b&gt; [deg/s]" in html and "<b>x</b>" not in html
+    assert "&lt;img src=x onerror=alert(1)&gt;.csv" in html and "<img src=x" not in html

@@ -73,3 +73,35 @@ def test_each_unit_json_read_once_at_the_end(
     assert sorted(reads) == ["a", "b", "c"]  # a first run: the summary's and report's reads
     assert [r["id"] for r in res.rows] == ["a", "b", "c"]
     assert [r["status"] for r in res.rows] == ["ok", "ok", "ok"]
+
+
+def test_every_unit_runs_its_thread_pools_on_one_thread(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """While a unit is fitted every BLAS/OpenMP pool loaded holds one thread (the fits are
+    one unit per core), unit after unit — the scan for the pools made once while no module
+    is imported between units — and the process's own threads are given back after."""
+    import threadpoolctl
+
+    from thermocal.pipeline import fit
+
+    for seed, uid in enumerate("abc"):
+        write_run(tmp_path / f"{uid}.csv", seed)
+    (tmp_path / "batch.toml").write_text(config_text({u: (f"{u}.csv", None) for u in "abc"}))
+    seen: list[set[int]] = []
+    real = fit.fit_files
+
+    def counted(*args: Any, **kwargs: Any) -> Any:
+        seen.append({p["num_threads"] for p in threadpoolctl.threadpool_info()})
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(fit, "fit_files", counted)
+    with threadpoolctl.threadpool_limits(limits=2):
+        before = [p["num_threads"] for p in threadpoolctl.threadpool_info()]
+        if max(before) < 2:
+            pytest.skip("no thread pool of more than one thread on this machine")
+        res = batch.run_fleet(load_config(tmp_path / "batch.toml"), tmp_path / "out")
+        after = [p["num_threads"] for p in threadpoolctl.threadpool_info()]
+    assert res.failed == ()
+    assert seen == [{1}, {1}, {1}]
+    assert after == before

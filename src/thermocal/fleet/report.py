@@ -81,6 +81,22 @@ def _figure_distributions(channel: str, ok: Mapping[str, Mapping[str, Any]]) -> 
         return _png(fig)
 
 
+def _templates() -> Any:
+    """The report templates as every report reads them (``thermocal.report``'s, escaped,
+    undefined names an error), without the calibration report's filters, which the batch's
+    template does not use: importing them (``thermocal.report.build`` and the analysis
+    modules behind it) was a fixed cost of every batch."""
+    import jinja2
+
+    return jinja2.Environment(
+        loader=jinja2.PackageLoader("thermocal.report", "templates"),
+        autoescape=jinja2.select_autoescape(["html", "j2"]),
+        trim_blocks=True,
+        lstrip_blocks=True,
+        undefined=jinja2.StrictUndefined,
+    )
+
+
 def build_fleet_report(
     config: FleetConfig,
     records: Mapping[str, Mapping[str, Any] | None],
@@ -105,7 +121,6 @@ def build_fleet_report(
         The self-contained HTML document.
     """
     from thermocal import __version__
-    from thermocal.report.build import _env
 
     units = []
     for u in config.units:
@@ -150,7 +165,7 @@ def build_fleet_report(
     n_failed = sum(1 for u in units if u["status"] == "failed")
     n_pass = sum(1 for u in units if u["status"] == "ok" and u["pass"] is True)
     html: str = (
-        _env()
+        _templates()
         .get_template("fleet.html.j2")
         .render(
             title=f"Production batch — {config.path.name}",
