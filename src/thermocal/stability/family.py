@@ -414,7 +414,7 @@ def _stretches(
 
 _LADDER_MIN: Final = 1 << 20
 """Phase records from this many points identify their noise on contiguous decimations
-(:meth:`_Record.decimated`); shorter ones read strided views (they fit in the cache)."""
+(:meth:`_Record.phase_r1`); shorter ones read strided views (they fit in the cache)."""
 
 
 class _Record:
@@ -439,9 +439,14 @@ class _Record:
         """Octave levels up to this factor (0: no octave levels; set by the caller)."""
         self.own = False
         """The caller gave ``y`` up: phase data are centred in its own buffer."""
-        self._ladder: tuple[int, FloatArray] | None = None
-        """``(k, x[::k])`` of the longest stretch's centred phase, contiguous: the last rung
-        of the phase decimations (:meth:`decimated`)."""
+        self._rung: tuple[int, FloatArray, int] | None = None
+        """``(k, buffer, n)``: ``buffer[:n]`` holds x[::k] − :func:`.edf.phase_shift` of
+        the longest stretch's centred phase x, the last rung of the phase decimations
+        (:meth:`phase_r1`); later rungs are written into the same buffer."""
+        self._r1: dict[int, tuple[float, ...]] = {}
+        """Per m, the r1 of the decimated phase's differences (:meth:`phase_r1`)."""
+        self.dmax = 3 if any(registry.get(n).hadamard for n in names) else 2
+        """Difference orders the phase identification gathers at once."""
 
     def set_octave(self, m: IntArray) -> None:
         """Rate data at octave factors only (every m a power of 2): adev, hdev and the noise
@@ -505,29 +510,39 @@ class _Record:
             if self.sizes[self.longest] - 1 < m:  # no m-average: nothing to identify
                 return ed.identify_rate_averages(np.zeros(0), dmax=dmax)
         x = self.centred()[self.longest]
-        if self.data_type == "phase":
-            z, k = self.decimated(x, m)
-            if k == m:  # the same points as x[::m], contiguous: the lag-1 path reads only them
-                return ed.identify_noise(z, 1, dmax=dmax, phase_input=True, rules=rules)
+        if self.data_type == "phase" and x[:: max(m, 1)].size >= ed.MIN_ACF_POINTS:
+            r1 = self.phase_r1(m, dmax)
+            return ed.identify_phase_lag1(r1, x[::m].size, dmax, rules)
         return ed.identify_noise(
             x, m, dmax=dmax, phase_input=self.data_type == "phase", rules=rules
         )
 
-    def decimated(self, x: FloatArray, m: int) -> tuple[FloatArray, int]:
-        """``(x[::k], k)`` with ``k = m`` as a contiguous copy taken from the last rung
-        (``x[::j]`` with j dividing m) when that is long and the lag-1 method will read it;
-        else ``(x, 1)``.  The identification decimates the phase by m and reads the result in
-        up to six passes: a strided view of a 10⁷-point phase costs a sweep of the whole
-        array per pass for m ≤ 8 (a cache line holds 8 points), the ladder's rungs one sweep
-        of the previous, halving rung.  The points, and so every sum, are the same."""
-        if m < 2 or x.size < _LADDER_MIN or x.size // m < ed.MIN_ACF_POINTS:
-            return x, 1
-        j, base = self._ladder if self._ladder is not None else (1, x)
-        if m % j:
-            j, base = 1, x
-        z = np.ascontiguousarray(base[:: m // j])
-        self._ladder = (m, z)
-        return z, m
+    def phase_r1(self, m: int, dmax: int) -> tuple[float, ...]:
+        """The r1 of x[::m] and of its differences up to order ``max(dmax, self.dmax)``
+        (:func:`.edf.lag1_of_differences`, one pass), x the longest stretch's centred phase;
+        kept per m.  From :data:`_LADDER_MIN` points and m ≥ 2 the decimation is written, in
+        the same pass, into one buffer reused from rung to rung: from the last rung when its
+        k divides m (read with stride m/k, in place), else from x.  A strided view of a
+        10⁷-point phase costs a sweep of the whole array for m ≤ 8 (a cache line holds 8
+        points), a rung one sweep of the previous, shorter one; the points, and so every
+        sum, are the same as :func:`.edf.identify_noise` reads."""
+        got = self._r1.get(m)
+        if got is not None and len(got) > dmax:
+            return got
+        x = self.centred()[self.longest]
+        order, shift = max(dmax, self.dmax), ed.phase_shift(x)
+        if m < 2 or x.size < _LADDER_MIN:
+            got = ed.lag1_of_differences(x[::m], order, shift=shift)
+        else:
+            n = x[::m].size
+            k, buf, nk = self._rung if self._rung is not None else (1, x[:0], 0)
+            src, off = (buf[:nk][:: m // k], 0.0) if k > 1 and m % k == 0 else (x[::m], shift)
+            if buf.size < n:
+                buf = np.empty(n)
+            got = ed.lag1_of_differences(src, order, shift=off, out=buf)
+            self._rung = (m, buf, n)
+        self._r1[m] = got
+        return got
 
     def sums(self, name: str, m: IntArray) -> tuple[FloatArray, FloatArray]:
         """The pooled deviation and term count of ``name`` per m over the stretches."""
