@@ -111,3 +111,24 @@ def test_reused_rungs_hold_the_strided_phase() -> None:
         nid, ref = rec.identify(m, 2), ed.identify_noise(x, m, dmax=2, phase_input=True)
         assert (nid.alpha, nid.method, nid.d) == (ref.alpha, ref.method, ref.d)
         assert nid.alpha_float == pytest.approx(ref.alpha_float, rel=0, abs=1e-13)
+
+
+def test_short_records_and_far_shifts() -> None:
+    """A record under the rung threshold reads strided views, as identify_noise does (the
+    same NoiseId, bit for bit); a shift far from the phase (its mean carrying Σ w²) is
+    taken in exact passes and gives the same r1 as the whole-array formula."""
+    rng = np.random.default_rng(3)
+    phase = np.cumsum(rng.standard_normal(5000)) + rng.standard_normal(5000) * 3.0
+    rec = family._Record(phase, [slice(0, 5000)], 1.0, "phase", ["oadev", "hdev"])
+    x = rec.centred()[rec.longest]
+    for m in (1, 2, 7, 100):
+        assert rec.identify(m, 3) == ed.identify_noise(x, m, dmax=3, phase_input=True), m
+    assert rec._rung is None
+    z = rng.standard_normal(3 * BLOCK + 5)
+    for shift in (100.0, -1000.0):  # |mean| ≫ σ = 1, still resolved by float64
+        want = [_r1_whole(np.diff(z - shift, d)) for d in range(3)]
+        got = ed.lag1_of_differences(z, 2, shift=shift)
+        np.testing.assert_allclose(got, want, rtol=0, atol=1e-12)
+        short = ed.lag1_of_differences(z[:1000], 2, shift=shift)
+        want = [_r1_whole(np.diff(z[:1000] - shift, d)) for d in range(3)]
+        np.testing.assert_allclose(short, want, rtol=0, atol=1e-12)

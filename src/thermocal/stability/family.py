@@ -366,7 +366,8 @@ def factors(
         if tau.size == 0 or not np.all(np.isfinite(tau)) or np.any(tau <= 0):
             raise ThermocalInputError("averaging times τ must be positive and finite")
         m = 2 * np.round(tau / (1.5 * tau0_s)) if theo1 else np.round(tau / tau0_s)
-    mi = np.unique(np.asarray(m).astype(np.int64))
+    mi = np.sort(np.asarray(m).astype(np.int64).ravel())  # unique: np.unique imports numpy.ma
+    mi = mi[np.concatenate(([True], mi[1:] != mi[:-1]))]
     return mi[(mi >= 1) & (mi <= m_max)]
 
 
