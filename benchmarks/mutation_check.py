@@ -4909,7 +4909,7 @@ MUTANTS: tuple[Mutant, ...] = (
     Mutant(
         "lag1-orders-carry",
         P + "stability/edf.py",
-        "b, a0 = min(a + _LAG_BLOCK, n), max(a - _CARRY, 0)",
+        "b, a0 = min(a + _LAG_BLOCK, n), max(a - carry, 0)",
         "b, a0 = min(a + _LAG_BLOCK, n), max(a - 1, 0)",
         _t("edf_lag1_orders"),
         "the one-pass lag-1 sums: each block's window repeats one point, not the differences' "

@@ -132,3 +132,13 @@ def test_short_records_and_far_shifts() -> None:
         short = ed.lag1_of_differences(z[:1000], 2, shift=shift)
         want = [_r1_whole(np.diff(z[:1000] - shift, d)) for d in range(3)]
         np.testing.assert_allclose(short, want, rtol=0, atol=1e-12)
+
+
+def test_orders_above_three() -> None:
+    """Orders beyond the Hadamard family's (a walk asked to go to d = 5) read windows long
+    enough for their differences: the whole-array formula to 1e-12."""
+    z = np.cumsum(np.cumsum(np.random.default_rng(4).standard_normal(2 * BLOCK + 77)))
+    want = [_r1_whole(np.diff(z, d)) for d in range(6)]
+    np.testing.assert_allclose(ed.lag1_of_differences(z, 5), want, rtol=0, atol=1e-12)
+    nid = ed.identify_noise(z, 1, dmax=5, phase_input=True)
+    assert nid.method == "lag1" and nid.d >= 2

@@ -1133,9 +1133,10 @@ difference order, stay in the processor's cache)."""
 
 _CARRY: Final = 4
 """Points of the previous block each block's window repeats: the third differences ending
-in the block and the lag pair across the boundary (orders up to 3)."""
+in the block and the lag pair across the boundary (orders up to 3; ``dmax + 1`` above, so
+that orders 2 and 3 read the same windows and give the same sums)."""
 
-_ONES: Final = np.ones(_LAG_BLOCK + _CARRY)
+_ONES: Final = np.ones(_LAG_BLOCK + 64)
 
 _LOST: Final = 1e-2
 """Below this fraction of Σ w² the centred Σ c² = Σ w² − N w̄² has lost digits to the mean
@@ -1213,7 +1214,7 @@ def lag1_of_differences(
     z : numpy.ndarray
         Phase points (a decimation x[::m]) [unit·s], at least ``dmax + 2``.
     dmax : int
-        Highest difference order (0 … 3).
+        Highest difference order (0 … 63; 2 for the Allan family, 3 for Hadamard).
     shift : float, optional
         Offset removed first [unit·s] (:func:`phase_shift`; default 0).
     out : numpy.ndarray, optional
@@ -1236,13 +1237,14 @@ def lag1_of_differences(
     - W. J. Riley, NIST SP 1065, 2008, §5.5.
     """
     n = z.size
-    if not 0 <= dmax < _CARRY or n < dmax + 2:
+    carry = max(_CARRY, dmax + 1)
+    if not 0 <= dmax < 64 or n < dmax + 2:
         raise ValueError(f"lag1_of_differences: order {dmax} of {n} points")
     acc = np.zeros((3, dmax + 1))
-    bufs = [np.empty(_LAG_BLOCK + _CARRY) for _ in range(dmax)]
-    work = np.empty(_LAG_BLOCK + _CARRY) if out is None else None
+    bufs = [np.empty(_LAG_BLOCK + carry) for _ in range(dmax)]
+    work = np.empty(_LAG_BLOCK + carry) if out is None else None
     for a in range(0, n, _LAG_BLOCK):
-        b, a0 = min(a + _LAG_BLOCK, n), max(a - _CARRY, 0)
+        b, a0 = min(a + _LAG_BLOCK, n), max(a - carry, 0)
         if work is not None:
             w = work[: b - a0]
             np.subtract(z[a0:b], shift, out=w)
