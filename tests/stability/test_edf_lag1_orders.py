@@ -142,3 +142,52 @@ def test_orders_above_three() -> None:
     np.testing.assert_allclose(ed.lag1_of_differences(z, 5), want, rtol=0, atol=1e-12)
     nid = ed.identify_noise(z, 1, dmax=5, phase_input=True)
     assert nid.method == "lag1" and nid.d >= 2
+
+
+@pytest.mark.parametrize("plan", [[1, 2, 4, 8, 16, 64, 3, 6, 1000], [1, 2, 4, 10, 20, 40, 100]])
+def test_next_rung_written_in_the_same_pass(plan: list[int]) -> None:
+    """With the factors planned (octave, decade, and ones the last rung does not divide),
+    each pass writes the next planned factor's rung behind it (the buffer holds x[::m'] −
+    shift for the next m' that m divides) and every r1 equals the strided phase's, bit for
+    bit; asked out of plan order, the r1 are still the strided phase's."""
+    n = (1 << 20) + 4321
+    rng = np.random.default_rng(8)
+    phase = np.cumsum(rng.standard_normal(n)) + rng.standard_normal(n) * 30.0
+    rec = family._Record(phase, [slice(0, n)], 0.01, "phase", ["oadev"])
+    rec.set_octave(np.array(sorted(plan), dtype=np.int64))
+    x = rec.centred()[rec.longest]
+    shift = ed.phase_shift(x)
+    ordered = sorted(plan)
+    for m in ordered:
+        assert rec.phase_r1(m, 2) == ed.lag1_of_differences(x[::m], 2, shift=shift), m
+        nxt = next((q for q in ordered if q > m and q % m == 0), 0)
+        if nxt:
+            assert rec._rung is not None
+            k, buf, size = rec._rung
+            assert (k, size) == (nxt, x[::nxt].size)
+            np.testing.assert_array_equal(buf[:size], x[::nxt] - shift)
+    late = family._Record(phase, [slice(0, n)], 0.01, "phase", ["oadev"])
+    late.set_octave(np.array(ordered, dtype=np.int64))
+    for m in reversed(ordered):
+        assert late.phase_r1(m, 2) == ed.lag1_of_differences(x[::m], 2, shift=shift), m
+
+
+def test_rung_needing_exact_passes_read_again() -> None:
+    """A long record whose first block sits far from the rest (the offset removed is the
+    first block's mean): the rungs' Σ w² is carried by the mean, the exact passes need the
+    series the next rung was written over, and the record reads x[::m] again: the same r1
+    as the strided phase, none NaN."""
+    n = 1 << 22
+    rng = np.random.default_rng(9)
+    phase = rng.standard_normal(n)
+    phase[:BLOCK] += 1000.0
+    phase[-1] += 1000.0  # the line through the end points is flat: centring keeps the step
+    rec = family._Record(phase, [slice(0, n)], 0.01, "phase", ["oadev"])
+    rec.set_octave(np.array([1, 2, 4], dtype=np.int64))
+    x = rec.centred()[rec.longest]
+    shift = ed.phase_shift(x)
+    for m in (1, 2, 4):
+        got = rec.phase_r1(m, 2)
+        assert got == ed.lag1_of_differences(x[::m], 2, shift=shift), m
+        assert np.all(np.isfinite(got))
+        assert got[0] == pytest.approx(_r1_whole(x[::m] - shift), rel=0, abs=1e-12)

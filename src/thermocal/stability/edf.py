@@ -1184,7 +1184,12 @@ def _block_orders(w: FloatArray, own: int, bufs: list[FloatArray], acc: FloatArr
 
 
 def lag1_of_differences(
-    z: FloatArray, dmax: int, *, shift: float = 0.0, out: FloatArray | None = None
+    z: FloatArray,
+    dmax: int,
+    *,
+    shift: float = 0.0,
+    out: FloatArray | None = None,
+    then: tuple[int, FloatArray] | None = None,
 ) -> tuple[float, ...]:
     r"""The lag-1 autocorrelation r1 of ``z − shift`` and of its differences of order 1 …
     ``dmax``, in one pass over ``z`` (Riley & Greenhall 2004, eq. 2, per order).
@@ -1193,7 +1198,8 @@ def lag1_of_differences(
     :data:`_LAG_BLOCK` points; each block, with the :data:`_CARRY` points before it, is
     shifted into a reused buffer (into ``out[a:b]``, a contiguous copy of the decimation,
     when ``out`` is given; ``z`` may then be ``out[:: s]`` itself, s ≥ 1: each block is
-    written where no later block reads) and differenced order by order into reused buffers.
+    written where no later block reads; read in place when ``z`` is contiguous and
+    ``shift`` 0) and differenced order by order into reused buffers.
     Per order d, with w = Δ^d (z − shift) of N = n − d points: Σ w² is gathered per block,
     and Σ w_k w_{k+1} with the pair across each block boundary for d = ``dmax``; below it
     the lag sum follows from the next order's squares, Σ w_k w_{k+1} = (2 Σ w² − w_0² −
@@ -1219,6 +1225,11 @@ def lag1_of_differences(
         Offset removed first [unit·s] (:func:`phase_shift`; default 0).
     out : numpy.ndarray, optional
         Receives ``z − shift`` (its first ``z.size`` points).
+    then : tuple of (int, numpy.ndarray), optional
+        ``(s, dest)``: the next decimation, (z − shift)[::s], written into ``dest`` in the
+        same pass (``dest`` may be ``z``'s or ``out``'s buffer: each block is written behind
+        every later window).  Where ``dest`` overwrites the series and an order needs the
+        exact passes, that order's r1 is NaN (read ``z`` again without ``then``).
 
     Returns
     -------
@@ -1237,15 +1248,46 @@ def lag1_of_differences(
     - W. J. Riley, NIST SP 1065, 2008, §5.5.
     """
     n = z.size
-    carry = max(_CARRY, dmax + 1)
     if not 0 <= dmax < 64 or n < dmax + 2:
         raise ValueError(f"lag1_of_differences: order {dmax} of {n} points")
+    head = z[: dmax + 1] - shift  # before ``out`` or ``then`` may overwrite z
+    tail = z[n - dmax - 1 :] - shift
+    acc = _blocked_sums(z, dmax, shift, out, then)
+    for d in range(dmax):  # Σ (w_{k+1} − w_k)² = Σ_{k≥1} w_k² + Σ_{k<N−1} w_k² − 2 Σ w_k w_{k+1}
+        first, last = float(np.diff(head, d)[0]), float(np.diff(tail, d)[-1])
+        acc[2, d] = (2.0 * acc[1, d] - first * first - last * last - acc[1, d + 1]) / 2.0
+    series: FloatArray | None = z if out is None else out[:n]
+    if then is not None and (
+        np.may_share_memory(then[1], z) or (out is not None and np.may_share_memory(then[1], out))
+    ):
+        series = None  # written over by the next decimation
+    off = 0.0 if out is not None else shift
+    return tuple(_r1_of_order(acc[:, d], d, n, head, tail, series, off) for d in range(dmax + 1))
+
+
+def _blocked_sums(
+    z: FloatArray,
+    dmax: int,
+    shift: float,
+    out: FloatArray | None,
+    then: tuple[int, FloatArray] | None,
+) -> FloatArray:
+    """The pass of :func:`lag1_of_differences`: per block its window (read in place when
+    ``z`` is contiguous and unshifted, else shifted into a buffer or into ``out``), its sums
+    (:func:`_block_orders`), then, with ``then = (s, dest)``, its points of global index
+    ≡ 0 (mod s) copied to ``dest[index // s]`` (behind every later window: ``dest`` may be
+    ``z``'s own buffer)."""
+    n = z.size
+    carry = max(_CARRY, dmax + 1)
     acc = np.zeros((3, dmax + 1))
     bufs = [np.empty(_LAG_BLOCK + carry) for _ in range(dmax)]
-    work = np.empty(_LAG_BLOCK + carry) if out is None else None
+    direct = out is None and shift == 0.0 and z.flags.c_contiguous
+    work = np.empty(_LAG_BLOCK + carry) if out is None and not direct else None
     for a in range(0, n, _LAG_BLOCK):
         b, a0 = min(a + _LAG_BLOCK, n), max(a - carry, 0)
-        if work is not None:
+        if direct:
+            w = z[a0:b]
+        elif work is not None:
             w = work[: b - a0]
             np.subtract(z[a0:b], shift, out=w)
         else:
@@ -1253,16 +1295,12 @@ def lag1_of_differences(
             np.subtract(z[a:b], shift, out=out[a:b])
             w = out[a0:b]
         _block_orders(w, a - a0, bufs, acc)
-    series = z if out is None else out[:n]
-    head = series[: dmax + 1] - (shift if out is None else 0.0)
-    tail = series[n - dmax - 1 :] - (shift if out is None else 0.0)
-    for d in range(dmax):  # Σ (w_{k+1} − w_k)² = Σ_{k≥1} w_k² + Σ_{k<N−1} w_k² − 2 Σ w_k w_{k+1}
-        first, last = float(np.diff(head, d)[0]), float(np.diff(tail, d)[-1])
-        acc[2, d] = (2.0 * acc[1, d] - first * first - last * last - acc[1, d + 1]) / 2.0
-    return tuple(
-        _r1_of_order(acc[:, d], d, n, head, tail, series, 0.0 if out is not None else shift)
-        for d in range(dmax + 1)
-    )
+        if then is not None:
+            step, dest = then
+            first = -a % step
+            pts = w[a - a0 + first :: step]
+            dest[(a + first) // step : (a + first) // step + pts.size] = pts
+    return acc
 
 
 def _r1_of_order(
@@ -1271,10 +1309,11 @@ def _r1_of_order(
     n: int,
     head: FloatArray,
     tail: FloatArray,
-    series: FloatArray,
+    series: FloatArray | None,
     shift: float,
 ) -> float:
-    """r1 of order d from its sums (:func:`lag1_of_differences`)."""
+    """r1 of order d from its sums (:func:`lag1_of_differences`); NaN where exact passes
+    are needed and the series is gone (``series`` None)."""
     big_n = n - d
     first, last = float(np.diff(head, d)[0]), float(np.diff(tail, d)[-1])
     if d == 0:
@@ -1287,6 +1326,8 @@ def _r1_of_order(
     if not sq > 0:
         return 0.0
     if not den > _LOST * sq:  # the mean carried Σ w²: exact passes
+        if series is None:
+            return math.nan
         if d == 0:
             return _lag1_centred(series, float(series.mean()))
         return _lag1_of_difference(series, d, shift)

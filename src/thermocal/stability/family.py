@@ -448,10 +448,15 @@ class _Record:
         """Per m, the r1 of the decimated phase's differences (:meth:`phase_r1`)."""
         self.dmax = 3 if any(registry.get(n).hadamard for n in names) else 2
         """Difference orders the phase identification gathers at once."""
+        self.plan: list[int] = []
+        """The common averaging factors, ascending (:meth:`set_octave`)."""
 
     def set_octave(self, m: IntArray) -> None:
-        """Rate data at octave factors only (every m a power of 2): adev, hdev and the noise
-        identification up to the largest m come from the octave levels."""
+        """The common factors ``m`` (ascending): the phase identification's next rung is
+        the next of them that the current one divides (:meth:`phase_r1`).  Rate data at
+        octave factors only (every m a power of 2): adev, hdev and the noise identification
+        up to the largest m come from the octave levels."""
+        self.plan = [int(k) for k in m]
         if self.data_type == "rate" and m.size and np.all(m & (m - 1) == 0):
             self.m_max = int(m.max())
 
@@ -521,28 +526,55 @@ class _Record:
     def phase_r1(self, m: int, dmax: int) -> tuple[float, ...]:
         """The r1 of x[::m] and of its differences up to order ``max(dmax, self.dmax)``
         (:func:`.edf.lag1_of_differences`, one pass), x the longest stretch's centred phase;
-        kept per m.  From :data:`_LADDER_MIN` points and m ≥ 2 the decimation is written, in
-        the same pass, into one buffer reused from rung to rung: from the last rung when its
-        k divides m (read with stride m/k, in place), else from x.  A strided view of a
-        10⁷-point phase costs a sweep of the whole array for m ≤ 8 (a cache line holds 8
-        points), a rung one sweep of the previous, shorter one; the points, and so every
-        sum, are the same as :func:`.edf.identify_noise` reads."""
+        kept per m.  From :data:`_LADDER_MIN` points the decimations are rungs of one
+        reused buffer (:meth:`_rung_r1`); the points, and so every sum, are those
+        :func:`.edf.identify_noise` reads from the strided phase."""
         got = self._r1.get(m)
         if got is not None and len(got) > dmax:
             return got
         x = self.centred()[self.longest]
         order, shift = max(dmax, self.dmax), ed.phase_shift(x)
-        if m < 2 or x.size < _LADDER_MIN:
+        if x.size < _LADDER_MIN:  # strided views (in the cache)
             got = ed.lag1_of_differences(x[::m], order, shift=shift)
         else:
-            n = x[::m].size
-            k, buf, nk = self._rung if self._rung is not None else (1, x[:0], 0)
-            src, off = (buf[:nk][:: m // k], 0.0) if k > 1 and m % k == 0 else (x[::m], shift)
-            if buf.size < n:
-                buf = np.empty(n)
-            got = ed.lag1_of_differences(src, order, shift=off, out=buf)
-            self._rung = (m, buf, n)
+            got = self._rung_r1(x, m, order, shift)
         self._r1[m] = got
+        return got
+
+    def _rung_r1(self, x: FloatArray, m: int, order: int, shift: float) -> tuple[float, ...]:
+        """:meth:`phase_r1` on a long record.  The pass over x[::m] reads the rung prepared
+        for m in place, or copies x[::m] into the buffer (from the last rung, stride m/k,
+        when its k divides m; else from x), and writes the next planned factor's rung (the
+        next of :attr:`plan` that m divides) behind it in the same pass.  A strided view of
+        a 10⁷-point phase costs a sweep of the whole array for m ≤ 8 (a cache line holds 8
+        points); a rung is read once, contiguous, and half of it written."""
+        k, buf, nk = self._rung if self._rung is not None else (0, x[:0], 0)
+        n = x[::m].size
+        nxt = next((q for q in self.plan if q > m and q % m == 0), 0)
+        n_next = x[::nxt].size if nxt else 0
+        if n_next < ed.MIN_ACF_POINTS:
+            nxt = n_next = 0
+        out: FloatArray | None = None
+        if k == m:
+            src, off = buf[:nk], 0.0
+        elif k and m % k == 0:
+            src, off, out = buf[:nk][:: m // k], 0.0, buf
+        elif m == 1:
+            src, off = x, shift
+        else:
+            src, off, out = x[::m], shift, buf
+        need = max(n_next, n if out is not None else 0)
+        if buf.size < need:  # the first rung (read from x: the old buffer is not its source)
+            buf = np.empty(need)
+            out = buf if out is not None else None
+        then = (nxt // m, buf) if nxt else None
+        got = ed.lag1_of_differences(src, order, shift=off, out=out, then=then)
+        if nxt:
+            self._rung = (nxt, buf, n_next)
+        elif out is not None:
+            self._rung = (m, buf, n)
+        if any(math.isnan(r) for r in got):  # exact passes on a series written over
+            got = ed.lag1_of_differences(x[::m], order, shift=shift)
         return got
 
     def sums(self, name: str, m: IntArray) -> tuple[FloatArray, FloatArray]:
