@@ -17,7 +17,9 @@ averaging factor (τ = m τ0).
 * :func:`edf_theo1`: Howe's empirical Theo1 EDF per noise type (SP 1065 §5.2.16).
 * :func:`identify_noise`: lag-1 autocorrelation (W. J. Riley and C. A. Greenhall, "Power law
   noise identification using the lag 1 autocorrelation", Proc. 18th EFTF, 2004), with the
-  B1 ratio (Barnes 1969; D. A. Howe et al., 2000) when fewer than 30 averaged points remain.
+  B1 ratio (Barnes 1969; D. A. Howe et al., 2000) when fewer than 30 averaged points remain;
+  on phase data the r1 of every difference order from one pass over the decimated phase
+  (:func:`lag1_of_differences`) and the walk on them (:func:`identify_phase_lag1`).
 """
 
 from __future__ import annotations
