@@ -90,20 +90,3 @@ def test_tierms_of_rate_takes_no_centred_copy() -> None:
     assert got.curves["tierms"].dev.tolist() == pytest.approx([1.0, 2.0], rel=2e-3)
     # the phase (8 B a sample) and the octave levels (8 B); the centred copy was 8 B more
     assert peak < 21 * n, peak / n
-
-
-def test_the_decimation_ladder_identifies_as_the_strided_phase() -> None:
-    """A phase record of 2²¹ points identifies its noise on contiguous decimations
-    (``_Record.decimated``): at every octave m and at m that the last rung does not divide,
-    the same NoiseId, bit for bit, as :func:`identify_noise` on the strided phase."""
-    n = 1 << 21
-    rng = np.random.default_rng(5)
-    phase = np.cumsum(rng.standard_normal(n)) * 1e-3 + rng.standard_normal(n) * 1e-4
-    rec = family._Record(phase, [slice(0, n)], 0.01, "phase", ["adev"])
-    x = rec.centred()[rec.longest]
-    for m in (2, 4, 8, 16, 3, 6, 12, 1024, 5000, 65536):
-        for dmax in (2, 3):
-            got = rec.identify(m, dmax)
-            assert rec._ladder is not None and rec._ladder[0] == m
-            assert got == ed.identify_noise(x, m, dmax=dmax, phase_input=True), (m, dmax)
-        assert np.array_equal(rec._ladder[1], x[::m])

@@ -17,13 +17,16 @@ averaging factor (τ = m τ0).
 * :func:`edf_theo1`: Howe's empirical Theo1 EDF per noise type (SP 1065 §5.2.16).
 * :func:`identify_noise`: lag-1 autocorrelation (W. J. Riley and C. A. Greenhall, "Power law
   noise identification using the lag 1 autocorrelation", Proc. 18th EFTF, 2004), with the
-  B1 ratio (Barnes 1969; D. A. Howe et al., 2000) when fewer than 30 averaged points remain.
+  B1 ratio (Barnes 1969; D. A. Howe et al., 2000) when fewer than 30 averaged points remain;
+  on phase data the r1 of every difference order from one pass over the decimated phase
+  (:func:`lag1_of_differences`) and the walk on them (:func:`identify_phase_lag1`).
 """
 
 from __future__ import annotations
 
 import itertools
 import math
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import Final
 
@@ -908,9 +911,9 @@ def identify_noise(
     -2
     """
     if phase_input and x[:: max(m, 1)].size >= MIN_ACF_POINTS:
-        z = x[:: max(m, 1)]  # a strided view: centred block by block, never copied whole
-        mu = float(z.mean())
-        return _lag1_differenced(_lag1_centred(z, mu), z, dmax, 2, rules.r1_sample, shift=mu)
+        z = x[:: max(m, 1)]  # a strided view: read block by block, never copied whole
+        r1 = lag1_of_differences(z, dmax, shift=phase_shift(x))
+        return identify_phase_lag1(r1, z.size, dmax, rules)
     nb = (x.size - 1) // m  # m-averages of the rate: (x_{(k+1)m} − x_{km}) / m
     ym = np.diff(x[: nb * m + 1 : m]) if nb else x[:0].copy()
     if m > 1:
@@ -1126,6 +1129,214 @@ def _lag1_of_difference(z: FloatArray, d: int, shift: float | None = None) -> fl
     return num / den if den > 0 else 0.0
 
 
+_LAG_BLOCK: Final = 1 << 15
+"""Points of the phase rung per block of :func:`lag1_of_differences` (its buffers, one per
+difference order, stay in the processor's cache)."""
+
+_CARRY: Final = 4
+"""Points of the previous block each block's window repeats: the third differences ending
+in the block and the lag pair across the boundary (orders up to 3; ``dmax + 1`` above, so
+that orders 2 and 3 read the same windows and give the same sums)."""
+
+_ONES: Final = np.ones(_LAG_BLOCK + 64)
+
+_LOST: Final = 1e-2
+"""Below this fraction of Σ w² the centred Σ c² = Σ w² − N w̄² has lost digits to the mean
+(a large frequency offset): :func:`lag1_of_differences` then takes that order's r1 in two
+exact passes instead."""
+
+
+def phase_shift(x: FloatArray) -> float:
+    """The offset :func:`lag1_of_differences` removes from a phase record ``x`` before its
+    sums: the mean of its first :data:`_LAG_BLOCK` points (numpy's).  One value per record,
+    so that a decimation read from ``x`` and one copied from an earlier rung hold the same
+    numbers.
+
+    Parameters
+    ----------
+    x : numpy.ndarray
+        Phase points [unit·s].
+
+    Returns
+    -------
+    float
+        The offset [unit·s].
+    """
+    return float(x[:_LAG_BLOCK].mean())
+
+
+def _block_orders(w: FloatArray, own: int, bufs: list[FloatArray], acc: FloatArray) -> None:
+    """Adds one block's sums to ``acc`` (column d the d-th differences of the window ``w``;
+    rows Σ w of order 0, Σ w² of every order, Σ w_k w_{k+1} of the highest order): the
+    differences whose last point lies in the block (``own``: where the block starts in
+    ``w``), the pairs whose second does."""
+    wd = w
+    top = acc.shape[1] - 1
+    for d in range(top + 1):
+        if d:
+            nxt = bufs[d - 1][: wd.size - 1]
+            np.subtract(wd[1:], wd[:-1], out=nxt)
+            wd = nxt
+        mine = wd[max(own - d, 0) :]
+        if d == 0:  # BLAS against ones: twice numpy's pairwise sum's speed
+            acc[0, 0] += float(mine @ _ONES[: mine.size])
+        acc[1, d] += float(mine @ mine)
+    p0 = max(own - top - 1, 0)
+    acc[2, top] += float(wd[p0:-1] @ wd[p0 + 1 :])
+
+
+def lag1_of_differences(
+    z: FloatArray,
+    dmax: int,
+    *,
+    shift: float = 0.0,
+    out: FloatArray | None = None,
+    then: tuple[int, FloatArray] | None = None,
+) -> tuple[float, ...]:
+    r"""The lag-1 autocorrelation r1 of ``z − shift`` and of its differences of order 1 …
+    ``dmax``, in one pass over ``z`` (Riley & Greenhall 2004, eq. 2, per order).
+
+    ``z`` (possibly a strided view of a longer phase) is read in blocks of
+    :data:`_LAG_BLOCK` points; each block, with the :data:`_CARRY` points before it, is
+    shifted into a reused buffer (into ``out[a:b]``, a contiguous copy of the decimation,
+    when ``out`` is given; ``z`` may then be ``out[:: s]`` itself, s ≥ 1: each block is
+    written where no later block reads; read in place when ``z`` is contiguous and
+    ``shift`` 0) and differenced order by order into reused buffers.
+    Per order d, with w = Δ^d (z − shift) of N = n − d points: Σ w² is gathered per block,
+    and Σ w_k w_{k+1} with the pair across each block boundary for d = ``dmax``; below it
+    the lag sum follows from the next order's squares, Σ w_k w_{k+1} = (2 Σ w² − w_0² −
+    w_{N−1}² − Σ (Δw)²) / 2 (one dot product fewer per order, and no loss where r1 → 1:
+    the small Σ (Δw)² is summed itself).  Σ w is the block sums' for d = 0 and, for d ≥ 1,
+    telescoped from the end points, Σ Δ^d v = Δ^{d−1}v_{N} − Δ^{d−1}v_0.  With w̄ = Σ w / N:
+
+    Σ c² = Σ w² − w̄ Σ w,   Σ c_k c_{k+1} = Σ w_k w_{k+1} − w̄ (2 Σ w − w_0 − w_{N−1})
+    + (N − 1) w̄²,   r1 = Σ c_k c_{k+1} / Σ c²  (0 when Σ c² = 0).
+
+    Where Σ c² < :data:`_LOST` · Σ w² (the mean dominating: a large frequency offset) that
+    order is taken in two exact passes (:func:`_lag1_centred`, :func:`_lag1_of_difference`).
+    Equal to the whole-array formula on ``np.diff(z − shift, d)`` but for the order of the
+    additions (≈ 1e-16 relative).
+
+    Parameters
+    ----------
+    z : numpy.ndarray
+        Phase points (a decimation x[::m]) [unit·s], at least ``dmax + 2``.
+    dmax : int
+        Highest difference order (0 … 63; 2 for the Allan family, 3 for Hadamard).
+    shift : float, optional
+        Offset removed first [unit·s] (:func:`phase_shift`; default 0).
+    out : numpy.ndarray, optional
+        Receives ``z − shift`` (its first ``z.size`` points).
+    then : tuple of (int, numpy.ndarray), optional
+        ``(s, dest)``: the next decimation, (z − shift)[::s], written into ``dest`` in the
+        same pass (``dest`` may be ``z``'s or ``out``'s buffer: each block is written behind
+        every later window).  Where ``dest`` overwrites the series and an order needs the
+        exact passes, that order's r1 is NaN (read ``z`` again without ``then``).
+
+    Returns
+    -------
+    tuple of float
+        r1 [1] of the differences of order 0 … ``dmax``.
+
+    Notes
+    -----
+    .. math:: r_1^{(d)} = \frac{\sum_k c_k c_{k+1}}{\sum_k c_k^2},\quad
+              c = \Delta^d (z - \mu) - \overline{\Delta^d (z - \mu)}
+
+    References
+    ----------
+    - W. J. Riley and C. A. Greenhall, "Power law noise identification using the lag 1
+      autocorrelation", Proc. 18th EFTF, 2004.
+    - W. J. Riley, NIST SP 1065, 2008, §5.5.
+    """
+    n = z.size
+    if not 0 <= dmax < 64 or n < dmax + 2:
+        raise ValueError(f"lag1_of_differences: order {dmax} of {n} points")
+    head = z[: dmax + 1] - shift  # before ``out`` or ``then`` may overwrite z
+    tail = z[n - dmax - 1 :] - shift
+    acc = _blocked_sums(z, dmax, shift, out, then)
+    for d in range(dmax):  # Σ (w_{k+1} − w_k)² = Σ_{k≥1} w_k² + Σ_{k<N−1} w_k² − 2 Σ w_k w_{k+1}
+        first, last = float(np.diff(head, d)[0]), float(np.diff(tail, d)[-1])
+        acc[2, d] = (2.0 * acc[1, d] - first * first - last * last - acc[1, d + 1]) / 2.0
+    series: FloatArray | None = z if out is None else out[:n]
+    if then is not None and (
+        np.may_share_memory(then[1], z) or (out is not None and np.may_share_memory(then[1], out))
+    ):
+        series = None  # written over by the next decimation
+    off = 0.0 if out is not None else shift
+    return tuple(_r1_of_order(acc[:, d], d, n, head, tail, series, off) for d in range(dmax + 1))
+
+
+def _blocked_sums(
+    z: FloatArray,
+    dmax: int,
+    shift: float,
+    out: FloatArray | None,
+    then: tuple[int, FloatArray] | None,
+) -> FloatArray:
+    """The pass of :func:`lag1_of_differences`: per block its window (read in place when
+    ``z`` is contiguous and unshifted, else shifted into a buffer or into ``out``), its sums
+    (:func:`_block_orders`), then, with ``then = (s, dest)``, its points of global index
+    ≡ 0 (mod s) copied to ``dest[index // s]`` (behind every later window: ``dest`` may be
+    ``z``'s own buffer)."""
+    n = z.size
+    carry = max(_CARRY, dmax + 1)
+    acc = np.zeros((3, dmax + 1))
+    bufs = [np.empty(_LAG_BLOCK + carry) for _ in range(dmax)]
+    direct = out is None and shift == 0.0 and z.flags.c_contiguous
+    work = np.empty(_LAG_BLOCK + carry) if out is None and not direct else None
+    for a in range(0, n, _LAG_BLOCK):
+        b, a0 = min(a + _LAG_BLOCK, n), max(a - carry, 0)
+        if direct:
+            w = z[a0:b]
+        elif work is not None:
+            w = work[: b - a0]
+            np.subtract(z[a0:b], shift, out=w)
+        else:
+            assert out is not None
+            np.subtract(z[a:b], shift, out=out[a:b])
+            w = out[a0:b]
+        _block_orders(w, a - a0, bufs, acc)
+        if then is not None:
+            step, dest = then
+            first = -a % step
+            pts = w[a - a0 + first :: step]
+            dest[(a + first) // step : (a + first) // step + pts.size] = pts
+    return acc
+
+
+def _r1_of_order(
+    acc: FloatArray,
+    d: int,
+    n: int,
+    head: FloatArray,
+    tail: FloatArray,
+    series: FloatArray | None,
+    shift: float,
+) -> float:
+    """r1 of order d from its sums (:func:`lag1_of_differences`); NaN where exact passes
+    are needed and the series is gone (``series`` None)."""
+    big_n = n - d
+    first, last = float(np.diff(head, d)[0]), float(np.diff(tail, d)[-1])
+    if d == 0:
+        total = float(acc[0])
+    else:
+        total = float(np.diff(tail, d - 1)[-1]) - float(np.diff(head, d - 1)[0])
+    mean = total / big_n
+    sq = float(acc[1])
+    den = sq - mean * total
+    if not sq > 0:
+        return 0.0
+    if not den > _LOST * sq:  # the mean carried Σ w²: exact passes
+        if series is None:
+            return math.nan
+        if d == 0:
+            return _lag1_centred(series, float(series.mean()))
+        return _lag1_of_difference(series, d, shift)
+    cross = float(acc[2]) - mean * (2.0 * total - first - last) + (big_n - 1) * mean * mean
+    return cross / den
+
+
 def _lag1_differenced(
     r1: float,
     z: FloatArray,
@@ -1139,9 +1350,21 @@ def _lag1_differenced(
     10⁷-sample m = 1 level needs no differenced copy).  ``sample``: every r1 (of n points)
     taken as r1·(n − 1)/n, Stable32's normalisation (:class:`IdRules`).  ``shift``: the
     series differenced is ``z − shift`` (the centred phase), formed block by block."""
+    return _riley_walk(
+        lambda d: r1 if d == 0 else _lag1_of_difference(z, d, shift), z.size, dm, add, sample
+    )
+
+
+def _riley_walk(
+    r1_of: Callable[[int], float], size: int, dm: int, add: int, sample: bool
+) -> NoiseId:
+    """Riley & Greenhall's walk on the r1 of each difference order (``r1_of(d)``, asked in
+    order, only as far as the walk goes) of a series of ``size`` points: stop at the first
+    d with ρ = r1/(1 + r1) < 0.25 (each r1 taken as r1·(n − 1)/n with ``sample``, n = size
+    − d) or at d = ``dm``; α = −round(2ρ) − 2d + ``add``."""
     d = 0
-    size = z.size
     while True:
+        r1 = r1_of(d)
         if sample:
             n = size - d
             r1 = r1 * (n - 1) / n if n > 1 else r1
@@ -1150,7 +1373,42 @@ def _lag1_differenced(
             a = -round(2.0 * rho) - 2 * d + add
             return NoiseId(int(a), -2.0 * (rho + d) + add, "lag1", d)
         d += 1
-        r1 = _lag1_of_difference(z, d, shift)
+
+
+def identify_phase_lag1(
+    r1: Sequence[float], size: int, dmax: int, rules: IdRules = THERMOCAL_RULES
+) -> NoiseId:
+    r"""The lag-1 identification of phase data (:func:`identify_noise`) from the r1 of the
+    decimated phase and of its differences (:func:`lag1_of_differences`): Riley & Greenhall's
+    walk, difference until ρ = r1/(1 + r1) < 0.25 or d = ``dmax``, α = −round(2ρ) − 2d + 2.
+
+    Parameters
+    ----------
+    r1 : sequence of float
+        r1 [1] of the decimated phase's differences of order 0 … at least ``dmax``.
+    size : int
+        Points of the decimated phase.
+    dmax : int
+        Difference order: 2 for the Allan family, 3 for Hadamard.
+    rules : IdRules, optional
+        Identification rules (``r1_sample``: Stable32's normalisation).
+
+    Returns
+    -------
+    NoiseId
+        Noise exponent α, method ``lag1`` and the differences taken.
+
+    Notes
+    -----
+    .. math:: \rho = r_1 / (1 + r_1),\quad \alpha = -\operatorname{round}(2\rho) - 2d + 2
+
+    References
+    ----------
+    - Riley & Greenhall 2004 (lag-1 autocorrelation).
+    """
+    if len(r1) <= dmax:
+        raise ValueError(f"identify_phase_lag1: {len(r1)} orders for dmax = {dmax}")
+    return _riley_walk(r1.__getitem__, size, dmax, 2, rules.r1_sample)
 
 
 def _b1_identify(

@@ -366,7 +366,8 @@ def factors(
         if tau.size == 0 or not np.all(np.isfinite(tau)) or np.any(tau <= 0):
             raise ThermocalInputError("averaging times τ must be positive and finite")
         m = 2 * np.round(tau / (1.5 * tau0_s)) if theo1 else np.round(tau / tau0_s)
-    mi = np.unique(np.asarray(m).astype(np.int64))
+    mi = np.sort(np.asarray(m).astype(np.int64).ravel())  # unique: np.unique imports numpy.ma
+    mi = mi[np.concatenate(([True], mi[1:] != mi[:-1]))]
     return mi[(mi >= 1) & (mi <= m_max)]
 
 
@@ -414,7 +415,7 @@ def _stretches(
 
 _LADDER_MIN: Final = 1 << 20
 """Phase records from this many points identify their noise on contiguous decimations
-(:meth:`_Record.decimated`); shorter ones read strided views (they fit in the cache)."""
+(:meth:`_Record.phase_r1`); shorter ones read strided views (they fit in the cache)."""
 
 
 class _Record:
@@ -439,13 +440,23 @@ class _Record:
         """Octave levels up to this factor (0: no octave levels; set by the caller)."""
         self.own = False
         """The caller gave ``y`` up: phase data are centred in its own buffer."""
-        self._ladder: tuple[int, FloatArray] | None = None
-        """``(k, x[::k])`` of the longest stretch's centred phase, contiguous: the last rung
-        of the phase decimations (:meth:`decimated`)."""
+        self._rung: tuple[int, FloatArray, int] | None = None
+        """``(k, buffer, n)``: ``buffer[:n]`` holds x[::k] − :func:`.edf.phase_shift` of
+        the longest stretch's centred phase x, the last rung of the phase decimations
+        (:meth:`phase_r1`); later rungs are written into the same buffer."""
+        self._r1: dict[int, tuple[float, ...]] = {}
+        """Per m, the r1 of the decimated phase's differences (:meth:`phase_r1`)."""
+        self.dmax = 3 if any(registry.get(n).hadamard for n in names) else 2
+        """Difference orders the phase identification gathers at once."""
+        self.plan: list[int] = []
+        """The common averaging factors, ascending (:meth:`set_octave`)."""
 
     def set_octave(self, m: IntArray) -> None:
-        """Rate data at octave factors only (every m a power of 2): adev, hdev and the noise
-        identification up to the largest m come from the octave levels."""
+        """The common factors ``m`` (ascending): the phase identification's next rung is
+        the next of them that the current one divides (:meth:`phase_r1`).  Rate data at
+        octave factors only (every m a power of 2): adev, hdev and the noise identification
+        up to the largest m come from the octave levels."""
+        self.plan = [int(k) for k in m]
         if self.data_type == "rate" and m.size and np.all(m & (m - 1) == 0):
             self.m_max = int(m.max())
 
@@ -505,29 +516,66 @@ class _Record:
             if self.sizes[self.longest] - 1 < m:  # no m-average: nothing to identify
                 return ed.identify_rate_averages(np.zeros(0), dmax=dmax)
         x = self.centred()[self.longest]
-        if self.data_type == "phase":
-            z, k = self.decimated(x, m)
-            if k == m:  # the same points as x[::m], contiguous: the lag-1 path reads only them
-                return ed.identify_noise(z, 1, dmax=dmax, phase_input=True, rules=rules)
+        if self.data_type == "phase" and x[:: max(m, 1)].size >= ed.MIN_ACF_POINTS:
+            r1 = self.phase_r1(m, dmax)
+            return ed.identify_phase_lag1(r1, x[::m].size, dmax, rules)
         return ed.identify_noise(
             x, m, dmax=dmax, phase_input=self.data_type == "phase", rules=rules
         )
 
-    def decimated(self, x: FloatArray, m: int) -> tuple[FloatArray, int]:
-        """``(x[::k], k)`` with ``k = m`` as a contiguous copy taken from the last rung
-        (``x[::j]`` with j dividing m) when that is long and the lag-1 method will read it;
-        else ``(x, 1)``.  The identification decimates the phase by m and reads the result in
-        up to six passes: a strided view of a 10⁷-point phase costs a sweep of the whole
-        array per pass for m ≤ 8 (a cache line holds 8 points), the ladder's rungs one sweep
-        of the previous, halving rung.  The points, and so every sum, are the same."""
-        if m < 2 or x.size < _LADDER_MIN or x.size // m < ed.MIN_ACF_POINTS:
-            return x, 1
-        j, base = self._ladder if self._ladder is not None else (1, x)
-        if m % j:
-            j, base = 1, x
-        z = np.ascontiguousarray(base[:: m // j])
-        self._ladder = (m, z)
-        return z, m
+    def phase_r1(self, m: int, dmax: int) -> tuple[float, ...]:
+        """The r1 of x[::m] and of its differences up to order ``max(dmax, self.dmax)``
+        (:func:`.edf.lag1_of_differences`, one pass), x the longest stretch's centred phase;
+        kept per m.  From :data:`_LADDER_MIN` points the decimations are rungs of one
+        reused buffer (:meth:`_rung_r1`); the points, and so every sum, are those
+        :func:`.edf.identify_noise` reads from the strided phase."""
+        got = self._r1.get(m)
+        if got is not None and len(got) > dmax:
+            return got
+        x = self.centred()[self.longest]
+        order, shift = max(dmax, self.dmax), ed.phase_shift(x)
+        if x.size < _LADDER_MIN:  # strided views (in the cache)
+            got = ed.lag1_of_differences(x[::m], order, shift=shift)
+        else:
+            got = self._rung_r1(x, m, order, shift)
+        self._r1[m] = got
+        return got
+
+    def _rung_r1(self, x: FloatArray, m: int, order: int, shift: float) -> tuple[float, ...]:
+        """:meth:`phase_r1` on a long record.  The pass over x[::m] reads the rung prepared
+        for m in place, or copies x[::m] into the buffer (from the last rung, stride m/k,
+        when its k divides m; else from x), and writes the next planned factor's rung (the
+        next of :attr:`plan` that m divides) behind it in the same pass.  A strided view of
+        a 10⁷-point phase costs a sweep of the whole array for m ≤ 8 (a cache line holds 8
+        points); a rung is read once, contiguous, and half of it written."""
+        k, buf, nk = self._rung if self._rung is not None else (0, x[:0], 0)
+        n = x[::m].size
+        nxt = next((q for q in self.plan if q > m and q % m == 0), 0)
+        n_next = x[::nxt].size if nxt else 0
+        if n_next < ed.MIN_ACF_POINTS:
+            nxt = n_next = 0
+        out: FloatArray | None = None
+        if k == m:
+            src, off = buf[:nk], 0.0
+        elif k and m % k == 0:
+            src, off, out = buf[:nk][:: m // k], 0.0, buf
+        elif m == 1:
+            src, off = x, shift
+        else:
+            src, off, out = x[::m], shift, buf
+        need = max(n_next, n if out is not None else 0)
+        if buf.size < need:  # the first rung (read from x: the old buffer is not its source)
+            buf = np.empty(need)
+            out = buf if out is not None else None
+        then = (nxt // m, buf) if nxt else None
+        got = ed.lag1_of_differences(src, order, shift=off, out=out, then=then)
+        if nxt:
+            self._rung = (nxt, buf, n_next)
+        elif out is not None:
+            self._rung = (m, buf, n)
+        if any(math.isnan(r) for r in got):  # exact passes on a series written over
+            got = ed.lag1_of_differences(x[::m], order, shift=shift)
+        return got
 
     def sums(self, name: str, m: IntArray) -> tuple[FloatArray, FloatArray]:
         """The pooled deviation and term count of ``name`` per m over the stretches."""
