@@ -9,9 +9,11 @@ the format up here (:func:`format_of`): :func:`thermocal.readers.read_recording`
 text logs.  A file whose format is not in the table is refused, never read as CSV.
 
 Other packages add formats through the entry-point group ``thermocal.formats``: each entry
-point names a :class:`FileFormat` object, loaded once, the first time a format is looked up.
-A plugin that cannot be loaded is skipped with one :class:`FormatPluginWarning`; it never
-stops the command line.
+point names a :class:`FileFormat` object, loaded once, the first time a lookup needs them: a
+file whose name or folder a built-in format recognises is read by it without looking at the
+installed packages (their metadata is read only for another name, a format asked for by a
+name thermocal does not have, or the list of every format).  A plugin that cannot be loaded
+is skipped with one :class:`FormatPluginWarning`; it never stops the command line.
 """
 
 from __future__ import annotations
@@ -21,7 +23,6 @@ import functools
 import warnings
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass
-from importlib import metadata
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Literal
 
@@ -287,6 +288,8 @@ BUILT_IN: tuple[FileFormat, ...] = (
 def _plugin_formats() -> list[FileFormat]:
     """The formats installed packages declare in :data:`ENTRY_POINT_GROUP`; a broken one is
     skipped with a :class:`FormatPluginWarning`."""
+    from importlib import metadata  # 10 ms of imports and a scan of every distribution
+
     out: list[FileFormat] = []
     taken = {f.name for f in BUILT_IN}
     claimed = {s for f in BUILT_IN for s in f.suffixes}
@@ -319,9 +322,14 @@ def _plugin_formats() -> list[FileFormat]:
 
 
 @functools.cache
+def _plugins() -> tuple[FileFormat, ...]:
+    """The plugins' formats (:func:`_plugin_formats`), loaded once a process."""
+    return tuple(_plugin_formats())
+
+
 def _installed() -> tuple[FileFormat, ...]:
-    """Built-in formats then plugins, loaded once a process."""
-    return (*BUILT_IN, *_plugin_formats())
+    """Built-in formats then plugins."""
+    return (*BUILT_IN, *_plugins())
 
 
 def registered_formats() -> tuple[FileFormat, ...]:
@@ -353,7 +361,10 @@ def format_named(name: str) -> FileFormat:
     thermocal.errors.ParameterError
         No format has that name (the registered ones are listed).
     """
-    for fmt in _installed():
+    for fmt in BUILT_IN:  # a built-in name needs no look at the installed packages
+        if fmt.name == name:
+            return fmt
+    for fmt in _plugins():
         if fmt.name == name:
             return fmt
     names = ", ".join(f.name for f in _installed())
@@ -362,7 +373,7 @@ def format_named(name: str) -> FileFormat:
 
 def _unknown_format_message(path: str | Path) -> str:
     """What to say of a file no registered format reads."""
-    plugins = [f for f in _installed() if f not in BUILT_IN and f.suffixes]
+    plugins = [f for f in _plugins() if f.suffixes]
     more = "".join(f", {', '.join(f.suffixes)} for {f.title}" for f in plugins)
     return (
         f"{path}: not a CSV or Parquet file (expected extension .csv, or .txt, .log, .tsv, "
@@ -373,7 +384,9 @@ def _unknown_format_message(path: str | Path) -> str:
 
 def format_of(path: str | Path) -> FileFormat:
     """The format of a file: the first registered format whose sniff function recognises the
-    path, else the one whose suffix ends its name (the longest that matches).
+    path, else the one whose suffix ends its name (the longest that matches).  The built-in
+    formats are tried first, sniff then suffix; the installed packages' formats (their
+    metadata read once) only for a path no built-in format recognises.
 
     Parameters
     ----------
@@ -398,28 +411,43 @@ def format_of(path: str | Path) -> FileFormat:
     ('a PX4 log', 'csv')
     """
     p = Path(path)
-    for fmt in _installed():
+    for fmt in BUILT_IN:
+        if fmt.sniff is not None and fmt.sniff(p):
+            return fmt
+    name = str(path).lower()
+    built_in = None if name.endswith(TEMP_SUFFIX) else _longest_suffix(name, BUILT_IN)
+    if built_in is not None:
+        return built_in
+    for fmt in _plugins():
         if fmt.sniff is not None and fmt.sniff(p):
             return fmt
     return _by_suffix(path)
 
 
+def _longest_suffix(name: str, formats: tuple[FileFormat, ...]) -> FileFormat | None:
+    """The format among ``formats`` whose suffix (the longest that matches) ends ``name``
+    (lower-case), or None."""
+    best: tuple[int, FileFormat] | None = None
+    for fmt in formats:
+        for s in fmt.suffixes:
+            if name.endswith(s) and (best is None or len(s) > best[0]):
+                best = (len(s), fmt)
+    return None if best is None else best[1]
+
+
 def _by_suffix(path: str | Path) -> FileFormat:
-    """The registered format whose suffix (the longest that matches) ends ``path``'s name."""
+    """The registered format whose suffix (the longest that matches) ends ``path``'s name: a
+    built-in one, else a plugin's (the installed packages looked at only then)."""
     name = str(path).lower()
     if name.endswith(TEMP_SUFFIX):
         raise FileFormatError(
             f"{path}: an unfinished output of an interrupted thermocal run, not a result; "
             "delete it (the next run to the same output removes it)"
         )
-    best: tuple[int, FileFormat] | None = None
-    for fmt in _installed():
-        for s in fmt.suffixes:
-            if name.endswith(s) and (best is None or len(s) > best[0]):
-                best = (len(s), fmt)
-    if best is None:
+    found = _longest_suffix(name, BUILT_IN) or _longest_suffix(name, _plugins())
+    if found is None:
         raise FileFormatError(_unknown_format_message(path))
-    return best[1]
+    return found
 
 
 def file_kind(path: str | Path) -> str:
