@@ -29,7 +29,6 @@ from typing import TYPE_CHECKING, Any, Literal
 from thermocal._lazy import LazyModule
 from thermocal.errors import FileFormatError, ParameterError, ThermocalWarning
 from thermocal.outputs import TEMP_SUFFIX
-from thermocal.readers import chunks as _chunks
 from thermocal.readers.common import (
     check_memory,
     check_unique_names,
@@ -38,27 +37,18 @@ from thermocal.readers.common import (
     csv_rows_estimate,
     thermocal_metadata,
 )
-from thermocal.readers.dataflash import read_dataflash
 from thermocal.readers.options import ReadOptions
 from thermocal.readers.station import is_station_path, read_station_table, with_sensor
-from thermocal.readers.table import ParquetColumns, csv_header_names
-from thermocal.readers.text import (
-    TooManyColumnsError,
-    check_column_count,
-    head_lines,
-    read_text,
-    sniff_text,
-)
-from thermocal.readers.ulog import read_ulog
+from thermocal.readers.table import ParquetColumns, csv_header_names, open_parquet
 
 if TYPE_CHECKING:
     import pandas as pd
     import pyarrow as pa
-    import pyarrow.parquet as pq
+
+    from thermocal.readers import chunks as _chunks
 else:
     pd = LazyModule("pandas")
     pa = LazyModule("pyarrow")
-    pq = LazyModule("pyarrow.parquet")
 
 ENTRY_POINT_GROUP = "thermocal.formats"
 """The entry-point group through which an installed package adds a :class:`FileFormat`."""
@@ -175,6 +165,14 @@ def _text_given(read: ReadOptions) -> ReadOptions | None:
 
 def _read_csv(path: Path, read: ReadOptions) -> tuple[Any, dict[str, Any]]:
     """A CSV file, or a text log whose layout (banner, delimiter, no header) it detects."""
+    from thermocal.readers.text import (
+        TooManyColumnsError,
+        check_column_count,
+        head_lines,
+        read_text,
+        sniff_text,
+    )
+
     text = _text_given(read)
     encoding = csv_encoding(path)
     # pandas holds every column of a CSV (and its parser about as much again)
@@ -218,7 +216,7 @@ def _read_csv(path: Path, read: ReadOptions) -> tuple[Any, dict[str, Any]]:
 def _read_parquet(path: Path, read: ReadOptions) -> tuple[Any, dict[str, Any]]:
     """A Parquet file, read lazily column by column (:class:`ParquetColumns`)."""
     try:
-        table = ParquetColumns(pq.ParquetFile(path, page_checksum_verification=True))
+        table = ParquetColumns(open_parquet(path))
     except (pa.ArrowInvalid, OSError) as exc:
         raise FileFormatError(f"{path}: not a readable Parquet file ({exc})") from None
     check_unique_names(path, table.column_names)
@@ -227,11 +225,15 @@ def _read_parquet(path: Path, read: ReadOptions) -> tuple[Any, dict[str, Any]]:
 
 def _read_ulog(path: Path, read: ReadOptions) -> tuple[Any, dict[str, Any]]:
     """One topic instance of a PX4 ULog (:func:`thermocal.readers.ulog.read_ulog`)."""
+    from thermocal.readers.ulog import read_ulog
+
     return read_ulog(path, read.topic)
 
 
 def _read_dataflash(path: Path, read: ReadOptions) -> tuple[Any, dict[str, Any]]:
     """One message of an ArduPilot DataFlash log (:func:`.dataflash.read_dataflash`)."""
+    from thermocal.readers.dataflash import read_dataflash
+
     return read_dataflash(path, read.topic)
 
 
@@ -243,7 +245,10 @@ def _read_bag(path: Path, read: ReadOptions) -> tuple[Any, dict[str, Any]]:
 
 
 def _is_ros2_bag(path: Path) -> bool:
-    """A ROS 2 bag folder (:func:`.bag.is_ros2_bag`)."""
+    """A ROS 2 bag folder (:func:`.bag.is_ros2_bag`; a file is none, and no reason to import
+    the bag reader)."""
+    if not path.is_dir():
+        return False
     from thermocal.readers.bag import is_ros2_bag
 
     return is_ros2_bag(path)
@@ -254,15 +259,30 @@ def _read_station(path: Path, read: ReadOptions) -> tuple[Any, dict[str, Any]]:
     return read_station_table(with_sensor(path, read.topic))
 
 
+def _chunked(name: str) -> Callable[..., Any]:
+    """The function ``name`` of :mod:`thermocal.readers.chunks`, imported at its first call
+    (the chunk readers are the chunked compensation's: a command that reads a file whole
+    never imports them)."""
+
+    def call(*args: Any) -> Any:
+        from thermocal.readers import chunks
+
+        return getattr(chunks, name)(*args)
+
+    call.__name__ = call.__qualname__ = name
+    call.__doc__ = f":func:`thermocal.readers.chunks.{name}`."
+    return call
+
+
 BUILT_IN: tuple[FileFormat, ...] = (
     FileFormat(
         "station", "a station recording folder", _read_station, chunks="stream",
-        head=_chunks.station_head, stream=_chunks.station_chunks,
+        head=_chunked("station_head"), stream=_chunked("station_chunks"),
         options=COLUMN_FIELDS | {"topic"}, sniff=is_station_path, locate=with_sensor,
     ),
     FileFormat(
         "parquet", "a Parquet file", _read_parquet, (".parquet", ".pq"), chunks="stream",
-        head=_chunks.parquet_head, stream=_chunks.parquet_chunks,
+        head=_chunked("parquet_head"), stream=_chunked("parquet_chunks"),
     ),
     FileFormat("ulog", "a PX4 log", _read_ulog, (".ulg",), options=COLUMN_FIELDS | {"topic"}),
     FileFormat(
@@ -276,7 +296,8 @@ BUILT_IN: tuple[FileFormat, ...] = (
     FileFormat(
         "csv", "a CSV file or text log", _read_csv,
         (".csv", ".txt", ".csv.gz", ".log", ".tsv", ".dat"), chunks="stream",
-        head=_chunks.csv_head, stream=_chunks.csv_chunks, options=COLUMN_FIELDS | TEXT_FIELDS,
+        head=_chunked("csv_head"), stream=_chunked("csv_chunks"),
+        options=COLUMN_FIELDS | TEXT_FIELDS,
     ),
 )  # fmt: skip
 """The formats thermocal reads itself, in the order they are tried."""
