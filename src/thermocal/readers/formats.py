@@ -103,7 +103,8 @@ class FileFormat:
         The :class:`ReadOptions` fields that apply (:data:`COLUMN_FIELDS`, plus ``topic``
         for a log of several topics, :data:`TEXT_FIELDS` for a text log).
     sniff : callable, optional
-        ``sniff(path) -> bool``: the path is this format whatever its suffix (tried first).
+        ``sniff(path) -> bool``: the path is this format whatever its suffix (tried first;
+        a plugin's for a path no built-in format recognises by sniff or suffix).
     locate : callable, optional
         ``locate(path, topic) -> path``: what ``head`` and ``stream`` read when ``topic``
         picks a part of ``path`` (a station folder's sensor, ``DIR/SENSOR``).
