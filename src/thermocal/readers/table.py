@@ -104,13 +104,39 @@ class ReaderFile:
         return [i for name in columns for i in self._leaves.get(name, [])]
 
     def read_row_group(self, i: int, columns: Sequence[str], use_threads: bool) -> pa.Table:
-        """The columns ``columns`` of row group ``i``."""
+        """The columns ``columns`` of row group ``i``.
+
+        Parameters
+        ----------
+        i : int
+            The row group.
+        columns : sequence of str
+            Column names (a nested column's name reads its leaves).
+        use_threads : bool
+            Decode the columns on pyarrow's threads.
+
+        Returns
+        -------
+        pyarrow.Table
+        """
         return self.reader.read_row_group(
             i, column_indices=self._indices(columns), use_threads=use_threads
         )
 
     def read(self, columns: Sequence[str], use_threads: bool) -> pa.Table:
-        """The columns ``columns``, read whole."""
+        """The columns ``columns``, read whole.
+
+        Parameters
+        ----------
+        columns : sequence of str
+            Column names (a nested column's name reads its leaves).
+        use_threads : bool
+            Decode the columns on pyarrow's threads.
+
+        Returns
+        -------
+        pyarrow.Table
+        """
         return self.reader.read_all(column_indices=self._indices(columns), use_threads=use_threads)
 
 
