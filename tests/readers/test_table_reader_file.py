@@ -93,3 +93,17 @@ def test_a_parquet_recording_is_read_without_pyarrow_parquet(path: Path) -> None
     assert proc.returncode == 0, proc.stderr
     gyro = pq.read_table(path, columns=["gyro"]).column(0).to_numpy()
     assert proc.stdout.split() == ["700", float(gyro.sum()).hex(), "False", "False"]
+
+
+def test_a_flat_column_named_like_a_nested_one_is_read_as_itself(path: Path) -> None:
+    """``imu.x`` beside a struct ``imu`` with a field ``x``: a name selects both (as
+    ``ParquetFile`` selects them), the flat column is the one read (an internal error
+    before: the struct was taken for it)."""
+    from thermocal.errors import UnitWarning
+    from thermocal.readers import ReadOptions, read_recording
+
+    with pytest.warns(UnitWarning, match="no unit stated"):  # the file states none
+        rec = read_recording(path, ReadOptions(signals=["gyro"]))
+    flat = pq.read_table(path, columns=["imu.x"]).column("imu.x").to_numpy()
+    assert np.array_equal(rec.columns["imu.x"], flat)
+    assert "imu" not in rec.columns  # a struct is no numeric column

@@ -242,7 +242,7 @@ class ParquetColumns:
                 for n in todo:  # one column chunk at a time: the decoding buffers of one
                     group = self._pf.read_row_group(i, columns=[n], use_threads=False)
                     k = 0
-                    for chunk in group.column(0).chunks:
+                    for chunk in group.column(n).chunks:
                         out[n][pos + k : pos + k + len(chunk)] = arrow_chunk_f64(chunk)
                         k += len(chunk)
                     del group
@@ -283,7 +283,7 @@ class ParquetColumns:
         pyarrow.ChunkedArray
             The column.
         """
-        col: pa.ChunkedArray = self._pf.read(columns=[name], use_threads=True).column(0)
+        col: pa.ChunkedArray = self._pf.read(columns=[name], use_threads=True).column(name)
         return col
 
     def column_f64(self, name: str) -> FloatArray | None:
@@ -311,7 +311,7 @@ class ParquetColumns:
         for i in range(self._pf.num_row_groups):
             # one column: no threads to share it among (on a loaded machine they halve
             # the speed)
-            col = self._pf.read_row_group(i, columns=[name], use_threads=False).column(0)
+            col = self._pf.read_row_group(i, columns=[name], use_threads=False).column(name)
             for chunk in col.chunks:
                 k = len(chunk)
                 out[pos : pos + k] = arrow_chunk_f64(chunk)  # nulls → NaN
