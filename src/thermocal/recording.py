@@ -851,7 +851,8 @@ def _scan_finite(time_s: FloatArray) -> TimeScan | None:
     buf = np.empty(min(n - 1, DIFF_BLOCK), dtype=np.float64)
     for a in range(0, n - 1, DIFF_BLOCK):
         dt = buf[: min(n - 1, a + DIFF_BLOCK) - a]
-        np.subtract(time_s[a + 1 : a + 1 + dt.size], time_s[a : a + dt.size], out=dt)
+        with np.errstate(over="ignore", invalid="ignore"):  # a step that is not finite: below
+            np.subtract(time_s[a + 1 : a + 1 + dt.size], time_s[a : a + dt.size], out=dt)
         b_lo, b_hi = float(dt.min()), float(dt.max())
         if not (math.isfinite(b_lo) and math.isfinite(b_hi)):
             return None

@@ -54,6 +54,16 @@ def test_time_steps_that_overflow_are_scanned_as_before() -> None:
     assert sc.max_step_s == np.inf
 
 
+@pytest.mark.parametrize("t", [[0.0, np.inf, np.inf], [-1e308, 1e308, np.nan], [np.nan, 1.0]])
+def test_stamps_that_are_not_finite_warn_of_no_arithmetic(t: list[float]) -> None:
+    """Not finite (said by ``finite``), without a numpy warning of a step computed on the
+    way (``inf − inf``, an overflow): the stamps are not differenced."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        sc = scan_time(np.array(t))
+    assert not sc.finite
+
+
 def _signal_rec(values: np.ndarray, unit: str) -> Recording:
     t = np.arange(values.size) * 0.01
     return Recording.from_arrays(t, {"g": values}, {}, signal_unit=unit)

@@ -248,7 +248,10 @@ def _read_bag(path: Path, read: ReadOptions) -> tuple[Any, dict[str, Any]]:
 def _is_ros2_bag(path: Path) -> bool:
     """A ROS 2 bag folder (:func:`.bag.is_ros2_bag`; a file is none, and no reason to import
     the bag reader)."""
-    if not path.is_dir():
+    try:
+        if not path.is_dir():
+            return False
+    except OSError:  # as is_ros2_bag answers it
         return False
     from thermocal.readers.bag import is_ros2_bag
 
