@@ -3637,8 +3637,8 @@ MUTANTS: tuple[Mutant, ...] = (
     Mutant(
         "formats-unknown-suffix-read-as-csv",
         P + "readers/formats.py",
-        "        raise FileFormatError(_unknown_format_message(path))\n    return best[1]",
-        "        return BUILT_IN[-1]\n    return best[1]",
+        "        raise FileFormatError(_unknown_format_message(path))\n    return found",
+        "        return BUILT_IN[-1]\n    return found",
         ("tests/readers/test_readers_formats.py",),
         "a file no registered format reads is read as CSV",
     ),
@@ -5204,6 +5204,56 @@ MUTANTS: tuple[Mutant, ...] = (
         "        if any(math.isnan(r) for r in got) and m < 0:",
         _t("edf_lag1_orders"),
         "a rung written over by the next one and needing exact passes: its r1 left NaN",
+    ),
+    Mutant(
+        "one-pass-scan-ignores-nan-steps",
+        P + "recording.py",
+        "        if not (math.isfinite(b_lo) and math.isfinite(b_hi)):\n            return None\n"
+        "        lo, hi = min(lo, b_lo), max(hi, b_hi)\n        if lo <= 0.0:",
+        "        lo, hi = min(lo, b_lo), max(hi, b_hi)\n        if lo <= 0.0:",
+        _t("recording_one_pass"),
+        "the one-pass time scan takes a NaN step for a finite one: NaN time passes",
+    ),
+    Mutant(
+        "jitter-bound-too-loose",
+        P + "recording.py",
+        "return bool(scan.finite and lo > 0 and hi - lo <= JITTER_RELATIVE * lo)",
+        "return bool(scan.finite and lo > 0 and hi - lo <= 4 * JITTER_RELATIVE * lo)",
+        _t("recording_one_pass"),
+        "jitter left unmeasured where it can exceed the threshold: the warning is lost",
+    ),
+    Mutant(
+        "finite-range-ignores-nan",
+        P + "recording.py",
+        "        if not (math.isfinite(b_lo) and math.isfinite(b_hi)):\n            return None\n"
+        "        lo, hi = min(lo, b_lo), max(hi, b_hi)\n    return lo, hi",
+        "        lo, hi = min(lo, b_lo), max(hi, b_hi)\n    return lo, hi",
+        _t("recording_one_pass"),
+        "a column with NaN taken as finite: the NaN error is lost",
+    ),
+    Mutant(
+        "signal-range-without-abs",
+        P + "recording.py",
+        "            if bool(np.all(np.abs(ends) <= limit)):",
+        "            if bool(np.all(ends <= limit)):",
+        _t("recording_one_pass"),
+        "a large negative rate taken as plausible: only the positive end checked",
+    ),
+    Mutant(
+        "parquet-columns-leaves-only",
+        P + "readers/table.py",
+        "            for k in range(1, len(parts) + 1):",
+        "            for k in range(len(parts), len(parts) + 1):",
+        _t("table_reader_file"),
+        "a nested column's name selects none of its leaves: ParquetFile reads them",
+    ),
+    Mutant(
+        "built-in-suffix-scans-plugins",
+        P + "readers/formats.py",
+        "    if built_in is not None:\n        return built_in\n",
+        "    if built_in is not None:\n        _plugins()\n        return built_in\n",
+        _t("format_plugin"),
+        "every lookup reads every installed package's metadata (10-30 ms a run)",
     ),
 )
 

@@ -829,6 +829,66 @@ def scan_time(time_s: FloatArray) -> TimeScan:
     (0.1, [2])
     """
     n = int(time_s.size)
+    if n >= 2:
+        fast = _scan_finite(time_s)
+        if fast is not None:  # the usual case: one pass, no mask as long as the column
+            return fast
+    return _scan_any(time_s)
+
+
+def _scan_finite(time_s: FloatArray) -> TimeScan | None:
+    """:func:`scan_time` of at least two stamps in one pass over the steps, each block's
+    steps written into one reused buffer; None when a step is not finite (NaN or ±inf:
+    :func:`_scan_any` then looks at the stamps themselves).  With every step finite and the
+    first stamp finite, every stamp is (``t[i+1]`` is finite when ``t[i]`` and
+    ``t[i+1] − t[i]`` are): the column's finiteness needs no pass of its own."""
+    n = int(time_s.size)
+    if time_s.dtype != np.float64 or not math.isfinite(float(time_s[0])):
+        return None
+    lo, hi = math.inf, -math.inf
+    dup_parts: list[npt.NDArray[np.intp]] = []
+    back_parts: list[npt.NDArray[np.intp]] = []
+    buf = np.empty(min(n - 1, DIFF_BLOCK), dtype=np.float64)
+    for a in range(0, n - 1, DIFF_BLOCK):
+        dt = buf[: min(n - 1, a + DIFF_BLOCK) - a]
+        with np.errstate(over="ignore", invalid="ignore"):  # a step that is not finite: below
+            np.subtract(time_s[a + 1 : a + 1 + dt.size], time_s[a : a + dt.size], out=dt)
+        b_lo, b_hi = float(dt.min()), float(dt.max())
+        if not (math.isfinite(b_lo) and math.isfinite(b_hi)):
+            return None
+        lo, hi = min(lo, b_lo), max(hi, b_hi)
+        if lo <= 0.0:
+            dup_parts.append(a + np.flatnonzero(dt == 0))
+            back_parts.append(a + np.flatnonzero(dt < 0))
+    return _time_scan(time_s, lo, hi, dup_parts, back_parts)
+
+
+def _time_scan(
+    time_s: FloatArray,
+    lo: float,
+    hi: float,
+    dup_parts: list[npt.NDArray[np.intp]],
+    back_parts: list[npt.NDArray[np.intp]],
+) -> TimeScan:
+    """The :class:`TimeScan` of a finite time column of at least two stamps from its
+    smallest and largest step and the rows of its zero and negative steps."""
+    n = int(time_s.size)
+    empty = np.zeros(0, dtype=np.intp)
+    dup = np.concatenate(dup_parts) if dup_parts else empty
+    back = np.concatenate(back_parts) if back_parts else empty
+    stamp_ulp = math.ulp(max(abs(float(time_s[0])), abs(float(time_s[-1]))))  # no overflow
+    regular = lo > 0 and hi - lo <= REGULAR_GRID_ULPS * stamp_ulp
+    if regular:
+        interval = float(time_s[-1] - time_s[0]) / (n - 1)
+    else:
+        interval = float(np.median(np.diff(time_s), overwrite_input=True))
+    return TimeScan(n, True, lo, hi, interval, regular, dup, back)
+
+
+def _scan_any(time_s: FloatArray) -> TimeScan:
+    """:func:`scan_time` of any time column: a mask of the finite stamps first (fewer than
+    two samples, or a stamp that is not finite, have no steps to scan)."""
+    n = int(time_s.size)
     empty = np.zeros(0, dtype=np.intp)
     nan = float("nan")
     if n < 2 or not bool(np.isfinite(time_s).all()):
@@ -843,15 +903,7 @@ def scan_time(time_s: FloatArray) -> TimeScan:
         if lo <= 0.0:
             dup_parts.append(a + np.flatnonzero(dt == 0))
             back_parts.append(a + np.flatnonzero(dt < 0))
-    dup = np.concatenate(dup_parts) if dup_parts else empty
-    back = np.concatenate(back_parts) if back_parts else empty
-    stamp_ulp = math.ulp(max(abs(float(time_s[0])), abs(float(time_s[-1]))))  # no overflow
-    regular = lo > 0 and hi - lo <= REGULAR_GRID_ULPS * stamp_ulp
-    if regular:
-        interval = float(time_s[-1] - time_s[0]) / (n - 1)
-    else:
-        interval = float(np.median(np.diff(time_s), overwrite_input=True))
-    return TimeScan(n, True, lo, hi, interval, regular, dup, back)
+    return _time_scan(time_s, lo, hi, dup_parts, back_parts)
 
 
 def median_interval(time_s: FloatArray) -> float:
@@ -1041,6 +1093,34 @@ def time_jitter(time_s: FloatArray) -> TimeJitter | None:
     return TimeJitter(med, (p95 - p5) / (2.0 * med), n_same, int(dt.size))
 
 
+def _jitter_bounded(scan: TimeScan) -> bool:
+    r"""Whether the smallest and largest of all the time steps (:func:`scan_time`) show
+    that the jitter of the first :data:`JITTER_STEPS` (:func:`time_jitter`) cannot be
+    significant, without measuring it.
+
+    Parameters
+    ----------
+    scan : TimeScan
+        The scan of the time column.
+
+    Returns
+    -------
+    bool
+        True when every step is positive and the steps spread by at most
+        :data:`JITTER_RELATIVE` of the smallest: then no step is of zero length and
+
+        .. math::
+            \mathrm{relative} = \frac{P_{95} - P_{5}}{2\,\mathrm{median}}
+            \le \frac{\Delta t_{\max} - \Delta t_{\min}}{2\,\Delta t_{\min}}
+            \le \frac{\mathrm{JITTER\_RELATIVE}}{2}
+
+        (the percentiles and the median of any steps lie between the smallest and the
+        largest), half the threshold: not significant.  False says nothing (measure it).
+    """
+    lo, hi = scan.min_step_s, scan.max_step_s
+    return bool(scan.finite and lo > 0 and hi - lo <= JITTER_RELATIVE * lo)
+
+
 def _median_p5_p95(steps: FloatArray) -> tuple[float, float, float]:
     """``np.median`` and ``np.percentile(…, [5, 95])`` (linear) of at least two finite
     values, equal to them to the bit, from one partition of ``steps`` (reordered in place)
@@ -1164,22 +1244,50 @@ def _column_problems(rec: Recording) -> tuple[list[Problem], dict[str, list[Prob
     nan: dict[str, list[Problem]] = {}
     plausible: dict[str, list[Problem]] = {}
     for name in order:
-        nan[name] = _nan_problems(rec, name, rec.columns[name])
+        arr = rec.columns[name]
+        span = _finite_range(arr)  # one pass: finite, and the signal's plausible range
+        nan[name] = [] if span is not None else _nan_problems(rec, name, arr)
         if name in rec.temperatures:
             plausible["T:" + name] = _temperature_problems(rec, name)
         if name in rec.signals:
-            plausible["S:" + name] = _signal_problems(rec, name) + _count_problems(rec, name)
+            found = _signal_problems(rec, name, span)
+            plausible["S:" + name] = found + _count_problems(rec, name)
     return [p for n in names for p in nan[n]], plausible
+
+
+RANGE_BLOCK = 1 << 16
+"""Values per block of :func:`_finite_range` (half a megabyte: each block's minimum and
+maximum are read while it is in the cache)."""
+
+
+def _finite_range(arr: FloatArray, block: int = RANGE_BLOCK) -> tuple[float, float] | None:
+    """The smallest and largest value of a float64 column whose every value is finite, in
+    one pass over its memory (block by block, each block's minimum then maximum); None for
+    an empty column, another dtype, or a NaN or infinite value anywhere (the minimum or
+    maximum of a block holding one is not finite)."""
+    if arr.size == 0 or arr.dtype != np.float64:
+        return None
+    lo, hi = math.inf, -math.inf
+    for a in range(0, arr.size, block):
+        part = arr[a : a + block]
+        b_lo, b_hi = float(part.min()), float(part.max())
+        if not (math.isfinite(b_lo) and math.isfinite(b_hi)):
+            return None
+        lo, hi = min(lo, b_lo), max(hi, b_hi)
+    return lo, hi
 
 
 RATE_HINT = "host timestamps? give {rate_hz} HZ to take the samples at the sensor's nominal rate"
 """What a duplicate timestamp's message says to do (``{rate_hz}``: the parameter)."""
 
 
-def _jitter_problems(t: FloatArray, found: list[Problem]) -> list[Problem]:
+def _jitter_problems(t: FloatArray, found: list[Problem], scan: TimeScan) -> list[Problem]:
     """Timestamp jitter (:func:`time_jitter`) as a warning, unless the time is already
-    refused as not finite or going backwards (``found``)."""
+    refused as not finite or going backwards (``found``), or the scan of every step
+    (:func:`scan_time`) bounds it below the threshold already (:func:`_jitter_bounded`)."""
     if any(p.kind in ("nonfinite_time", "backwards_time") for p in found):
+        return []
+    if _jitter_bounded(scan):
         return []
     jit = time_jitter(t)
     if jit is None or not jit.significant:
@@ -1272,7 +1380,7 @@ def find_problems(rec: Recording, required: list[str] | None = None) -> list[Pro
                 probs.append(Problem("unit", f"column {name!r}: {exc}", column=name))
     if t.size < 2:
         probs.append(Problem("too_short", "the recording has fewer than 2 samples"))
-    probs.extend(_jitter_problems(t, probs))
+    probs.extend(_jitter_problems(t, probs, scan))
     if not any(p.kind in ("nonfinite_time", "duplicate_time", "backwards_time") for p in probs):
         gaps = rec.gaps()
         if gaps:
@@ -1625,9 +1733,15 @@ def _temperature_problems(rec: Recording, name: str) -> list[Problem]:
     return probs
 
 
-def _signal_problems(rec: Recording, name: str) -> list[Problem]:
+def _signal_problems(
+    rec: Recording, name: str, span: tuple[float, float] | None = None
+) -> list[Problem]:
     """The first value of a signal column beyond any sensor once in its canonical unit
-    (an error naming the row), scanned in blocks of :data:`DIFF_BLOCK` rows."""
+    (an error naming the row), scanned in blocks of :data:`DIFF_BLOCK` rows.  ``span``: the
+    column's smallest and largest value when every value is finite (:func:`_finite_range`):
+    a unit's conversion multiplies by one factor, so that when both ends are within the
+    limit every value is (a rounded product is monotonic in the value) and no block is
+    scanned."""
     probs: list[Problem] = []
     arr = rec.columns.get(name)
     unit = rec.units.get(name)
@@ -1646,6 +1760,11 @@ def _signal_problems(rec: Recording, name: str) -> list[Problem]:
         canon_unit, limit = unit, PLAUSIBLE_COUNTS  # counts stay counts
     else:
         canon_unit, limit = units.canonical_unit(unit), PLAUSIBLE_SIGNAL[kind]
+        if span is not None:
+            with np.errstate(over="ignore"):
+                ends, _ = units.to_canonical(np.array(span), unit, finite=False)
+            if bool(np.all(np.abs(ends) <= limit)):
+                return probs
     for a0 in range(0, arr.size, DIFF_BLOCK):  # in blocks: bounded working memory
         part = arr[a0 : a0 + DIFF_BLOCK]
         with np.errstate(over="ignore", invalid="ignore"):

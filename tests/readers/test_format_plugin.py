@@ -194,3 +194,54 @@ def test_a_broken_plugin_is_one_warning_and_skipped(toy: dict[str, object]) -> N
     assert len(warned) == 1
     assert warned[0].startswith("warning: ")
     assert "ModuleNotFoundError" in warned[0] and "skipped" in warned[0]
+
+
+def test_a_built_in_format_never_looks_at_the_installed_packages(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """A name a built-in format claims is looked up without reading any package's metadata
+    (``importlib.metadata``: 10–30 ms a run); another name, or the list of every format,
+    reads it once."""
+    from thermocal.errors import FileFormatError
+    from thermocal.readers import formats
+
+    scans: list[int] = []
+    monkeypatch.setattr(formats, "_plugin_formats", lambda: scans.append(1) or [])
+    formats._plugins.cache_clear()
+    try:
+        names = [formats.format_of(p).name for p in ("a.parquet", "b.CSV.gz", "c.ulg", "d.bin")]
+        assert names == ["parquet", "csv", "ulog", "dataflash"]
+        assert formats.file_kind("e.mcap") == "rosbag"
+        assert formats.file_suffix("f.pq") == ".pq"
+        assert formats.format_named("csv").name == "csv"
+        assert scans == []
+        with pytest.raises(FileFormatError, match="not a CSV or Parquet file"):
+            formats.format_of("g.toy")
+        assert scans == [1]
+        assert [f.name for f in formats.registered_formats()] == [f.name for f in formats.BUILT_IN]
+        assert scans == [1]  # once a process
+    finally:
+        formats._plugins.cache_clear()
+
+
+def test_reading_parquet_imports_no_package_metadata(tmp_path: Path) -> None:
+    """A fresh interpreter reads a Parquet recording without importing
+    ``importlib.metadata`` (the plugin scan's import)."""
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    path = tmp_path / "r.parquet"
+    t = np.arange(100) * 0.1
+    pq.write_table(pa.table({"time": t, "gx": np.sin(t)}), path)
+    code = (
+        "import sys; from thermocal.readers import ReadOptions, read_recording; "
+        f"rec = read_recording({str(path)!r}, ReadOptions(signals=['gx'])); "
+        "print(rec.n_samples, 'importlib.metadata' in sys.modules)"
+    )
+    src = Path(thermocal.__file__).resolve().parents[1]
+    proc = subprocess.run(
+        [sys.executable, "-c", code], env={**os.environ, "PYTHONPATH": str(src)},
+        capture_output=True, text=True, timeout=300, check=False,
+    )  # fmt: skip
+    assert proc.returncode == 0, proc.stderr
+    assert proc.stdout.split() == ["100", "False"]

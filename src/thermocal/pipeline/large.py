@@ -36,7 +36,7 @@ from thermocal.readers.common import (
     memory_limit_bytes,
 )
 from thermocal.readers.options import ReadOptions
-from thermocal.readers.table import ParquetColumns
+from thermocal.readers.table import ParquetColumns, open_parquet
 
 if TYPE_CHECKING:
     import pyarrow as pa
@@ -93,7 +93,7 @@ def needs_streaming(
     if p.suffix.lower() not in (".parquet", ".pq") or not p.is_file():
         return False
     try:
-        rows = int(pq.ParquetFile(p).metadata.num_rows)
+        rows = int(open_parquet(p, checksums=False).metadata.num_rows)
     except Exception:  # an unreadable file: the ordinary reader names what is wrong
         return False
     limit = memory_budget if memory_budget is not None else memory_limit_bytes()

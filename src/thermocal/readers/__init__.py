@@ -23,12 +23,13 @@ flight-controller logs themselves: :func:`ulog_sensor_instances`,
 :func:`read_dataflash_log`, :func:`dataflash_table`, and :func:`parse_topic` for a topic.
 """
 
+from typing import TYPE_CHECKING, Any
+
 from thermocal.readers.common import (
     DEFAULT_DATAFLASH_TOPIC,
     DEFAULT_ULOG_TOPIC,
     parse_topic,
 )
-from thermocal.readers.dataflash import dataflash_table, read_dataflash_log
 from thermocal.readers.dispatch import read_recording, read_whole_table, recording_info
 from thermocal.readers.formats import (
     FileFormat,
@@ -37,7 +38,27 @@ from thermocal.readers.formats import (
     registered_formats,
 )
 from thermocal.readers.options import ReadOptions
-from thermocal.readers.ulog import ulog_sensor_instances
+
+if TYPE_CHECKING:
+    from thermocal.readers.dataflash import dataflash_table, read_dataflash_log
+    from thermocal.readers.ulog import ulog_sensor_instances
+
+_LATER = {
+    "dataflash_table": "thermocal.readers.dataflash",
+    "read_dataflash_log": "thermocal.readers.dataflash",
+    "ulog_sensor_instances": "thermocal.readers.ulog",
+}
+"""The flight-controller logs' entry points, imported at their first use (a command reading
+a table never imports the log readers)."""
+
+
+def __getattr__(name: str) -> Any:
+    if name in _LATER:
+        import importlib
+
+        return getattr(importlib.import_module(_LATER[name]), name)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
 
 __all__ = [
     "DEFAULT_DATAFLASH_TOPIC",

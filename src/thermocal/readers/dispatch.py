@@ -39,7 +39,6 @@ from thermocal.readers.table import (
     load_sidecar,
     numeric_column,
 )
-from thermocal.readers.text import counter_column, counter_time, rate_time
 from thermocal.recording import (
     META_FORMAT,
     META_VERSION,
@@ -138,6 +137,8 @@ def read_whole_table(path: str | Path, read: ReadOptions) -> tuple[pd.DataFrame,
         raise FileFormatError(f"{p}: {fmt.title} ({fmt.name}) is not read whole as one table")
     names = list(obj.columns)
     if read.rate_hz is not None:
+        from thermocal.readers.text import rate_time
+
         obj, names, t_col, t_unit, _mode = rate_time(
             p, obj, names, info, read.time, None, read, allow_column=False
         )
@@ -328,6 +329,8 @@ def time_hint(names: list[str], banner: Sequence[str] = ()) -> str:
     >>> time_hint(["n", "gyro"], ["rate: 50 Hz"])
     " (the file's banner says 'rate: 50 Hz': give {rate_hz} 50)"
     """
+    from thermocal.readers.text import counter_column
+
     counter = counter_column(names)
     temp_like = [n for n in names if named_like_temperature(n)]
     stated = [(b, m.group(4)) for b in banner if (m := _BANNER_RATE.match(b))]
@@ -460,6 +463,8 @@ def _time_s(
     (``"stamps"``), as :func:`~thermocal.readers.text.rate_time` found them."""
     rate = text.rate_hz
     if mode == "counter" and rate is not None:
+        from thermocal.readers.text import counter_time
+
         return counter_time(p, col, t, rate)
     if unit != "s":
         t = t * units.TIME_UNITS[unit]
@@ -703,6 +708,8 @@ def table_recording(
     time, time_unit = r.time, r.time_unit
     mode = None  # rate_hz: "rows", "counter" or "stamps" (rate_time)
     if r.rate_hz is not None:
+        from thermocal.readers.text import rate_time
+
         obj, names, time, time_unit, mode = rate_time(p, obj, names, info, time, time_unit, r)
     n_rows = _n_rows(p, obj, names)
     md = Metadata.from_dict(dict(info.get("metadata") or {}))

@@ -9,9 +9,11 @@ the format up here (:func:`format_of`): :func:`thermocal.readers.read_recording`
 text logs.  A file whose format is not in the table is refused, never read as CSV.
 
 Other packages add formats through the entry-point group ``thermocal.formats``: each entry
-point names a :class:`FileFormat` object, loaded once, the first time a format is looked up.
-A plugin that cannot be loaded is skipped with one :class:`FormatPluginWarning`; it never
-stops the command line.
+point names a :class:`FileFormat` object, loaded once, the first time a lookup needs them: a
+file whose name or folder a built-in format recognises is read by it without looking at the
+installed packages (their metadata is read only for another name, a format asked for by a
+name thermocal does not have, or the list of every format).  A plugin that cannot be loaded
+is skipped with one :class:`FormatPluginWarning`; it never stops the command line.
 """
 
 from __future__ import annotations
@@ -21,14 +23,12 @@ import functools
 import warnings
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass
-from importlib import metadata
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Literal
 
 from thermocal._lazy import LazyModule
 from thermocal.errors import FileFormatError, ParameterError, ThermocalWarning
 from thermocal.outputs import TEMP_SUFFIX
-from thermocal.readers import chunks as _chunks
 from thermocal.readers.common import (
     check_memory,
     check_unique_names,
@@ -37,27 +37,18 @@ from thermocal.readers.common import (
     csv_rows_estimate,
     thermocal_metadata,
 )
-from thermocal.readers.dataflash import read_dataflash
 from thermocal.readers.options import ReadOptions
 from thermocal.readers.station import is_station_path, read_station_table, with_sensor
-from thermocal.readers.table import ParquetColumns, csv_header_names
-from thermocal.readers.text import (
-    TooManyColumnsError,
-    check_column_count,
-    head_lines,
-    read_text,
-    sniff_text,
-)
-from thermocal.readers.ulog import read_ulog
+from thermocal.readers.table import ParquetColumns, csv_header_names, open_parquet
 
 if TYPE_CHECKING:
     import pandas as pd
     import pyarrow as pa
-    import pyarrow.parquet as pq
+
+    from thermocal.readers import chunks as _chunks
 else:
     pd = LazyModule("pandas")
     pa = LazyModule("pyarrow")
-    pq = LazyModule("pyarrow.parquet")
 
 ENTRY_POINT_GROUP = "thermocal.formats"
 """The entry-point group through which an installed package adds a :class:`FileFormat`."""
@@ -112,7 +103,8 @@ class FileFormat:
         The :class:`ReadOptions` fields that apply (:data:`COLUMN_FIELDS`, plus ``topic``
         for a log of several topics, :data:`TEXT_FIELDS` for a text log).
     sniff : callable, optional
-        ``sniff(path) -> bool``: the path is this format whatever its suffix (tried first).
+        ``sniff(path) -> bool``: the path is this format whatever its suffix (tried first;
+        a plugin's for a path no built-in format recognises by sniff or suffix).
     locate : callable, optional
         ``locate(path, topic) -> path``: what ``head`` and ``stream`` read when ``topic``
         picks a part of ``path`` (a station folder's sensor, ``DIR/SENSOR``).
@@ -174,6 +166,14 @@ def _text_given(read: ReadOptions) -> ReadOptions | None:
 
 def _read_csv(path: Path, read: ReadOptions) -> tuple[Any, dict[str, Any]]:
     """A CSV file, or a text log whose layout (banner, delimiter, no header) it detects."""
+    from thermocal.readers.text import (
+        TooManyColumnsError,
+        check_column_count,
+        head_lines,
+        read_text,
+        sniff_text,
+    )
+
     text = _text_given(read)
     encoding = csv_encoding(path)
     # pandas holds every column of a CSV (and its parser about as much again)
@@ -217,7 +217,7 @@ def _read_csv(path: Path, read: ReadOptions) -> tuple[Any, dict[str, Any]]:
 def _read_parquet(path: Path, read: ReadOptions) -> tuple[Any, dict[str, Any]]:
     """A Parquet file, read lazily column by column (:class:`ParquetColumns`)."""
     try:
-        table = ParquetColumns(pq.ParquetFile(path, page_checksum_verification=True))
+        table = ParquetColumns(open_parquet(path))
     except (pa.ArrowInvalid, OSError) as exc:
         raise FileFormatError(f"{path}: not a readable Parquet file ({exc})") from None
     check_unique_names(path, table.column_names)
@@ -226,11 +226,15 @@ def _read_parquet(path: Path, read: ReadOptions) -> tuple[Any, dict[str, Any]]:
 
 def _read_ulog(path: Path, read: ReadOptions) -> tuple[Any, dict[str, Any]]:
     """One topic instance of a PX4 ULog (:func:`thermocal.readers.ulog.read_ulog`)."""
+    from thermocal.readers.ulog import read_ulog
+
     return read_ulog(path, read.topic)
 
 
 def _read_dataflash(path: Path, read: ReadOptions) -> tuple[Any, dict[str, Any]]:
     """One message of an ArduPilot DataFlash log (:func:`.dataflash.read_dataflash`)."""
+    from thermocal.readers.dataflash import read_dataflash
+
     return read_dataflash(path, read.topic)
 
 
@@ -242,7 +246,13 @@ def _read_bag(path: Path, read: ReadOptions) -> tuple[Any, dict[str, Any]]:
 
 
 def _is_ros2_bag(path: Path) -> bool:
-    """A ROS 2 bag folder (:func:`.bag.is_ros2_bag`)."""
+    """A ROS 2 bag folder (:func:`.bag.is_ros2_bag`; a file is none, and no reason to import
+    the bag reader)."""
+    try:
+        if not path.is_dir():
+            return False
+    except OSError:  # as is_ros2_bag answers it
+        return False
     from thermocal.readers.bag import is_ros2_bag
 
     return is_ros2_bag(path)
@@ -253,15 +263,30 @@ def _read_station(path: Path, read: ReadOptions) -> tuple[Any, dict[str, Any]]:
     return read_station_table(with_sensor(path, read.topic))
 
 
+def _chunked(name: str) -> Callable[..., Any]:
+    """The function ``name`` of :mod:`thermocal.readers.chunks`, imported at its first call
+    (the chunk readers are the chunked compensation's: a command that reads a file whole
+    never imports them)."""
+
+    def call(*args: Any) -> Any:
+        from thermocal.readers import chunks
+
+        return getattr(chunks, name)(*args)
+
+    call.__name__ = call.__qualname__ = name
+    call.__doc__ = f":func:`thermocal.readers.chunks.{name}`."
+    return call
+
+
 BUILT_IN: tuple[FileFormat, ...] = (
     FileFormat(
         "station", "a station recording folder", _read_station, chunks="stream",
-        head=_chunks.station_head, stream=_chunks.station_chunks,
+        head=_chunked("station_head"), stream=_chunked("station_chunks"),
         options=COLUMN_FIELDS | {"topic"}, sniff=is_station_path, locate=with_sensor,
     ),
     FileFormat(
         "parquet", "a Parquet file", _read_parquet, (".parquet", ".pq"), chunks="stream",
-        head=_chunks.parquet_head, stream=_chunks.parquet_chunks,
+        head=_chunked("parquet_head"), stream=_chunked("parquet_chunks"),
     ),
     FileFormat("ulog", "a PX4 log", _read_ulog, (".ulg",), options=COLUMN_FIELDS | {"topic"}),
     FileFormat(
@@ -275,7 +300,8 @@ BUILT_IN: tuple[FileFormat, ...] = (
     FileFormat(
         "csv", "a CSV file or text log", _read_csv,
         (".csv", ".txt", ".csv.gz", ".log", ".tsv", ".dat"), chunks="stream",
-        head=_chunks.csv_head, stream=_chunks.csv_chunks, options=COLUMN_FIELDS | TEXT_FIELDS,
+        head=_chunked("csv_head"), stream=_chunked("csv_chunks"),
+        options=COLUMN_FIELDS | TEXT_FIELDS,
     ),
 )  # fmt: skip
 """The formats thermocal reads itself, in the order they are tried."""
@@ -287,6 +313,8 @@ BUILT_IN: tuple[FileFormat, ...] = (
 def _plugin_formats() -> list[FileFormat]:
     """The formats installed packages declare in :data:`ENTRY_POINT_GROUP`; a broken one is
     skipped with a :class:`FormatPluginWarning`."""
+    from importlib import metadata  # 10 ms of imports and a scan of every distribution
+
     out: list[FileFormat] = []
     taken = {f.name for f in BUILT_IN}
     claimed = {s for f in BUILT_IN for s in f.suffixes}
@@ -319,9 +347,14 @@ def _plugin_formats() -> list[FileFormat]:
 
 
 @functools.cache
+def _plugins() -> tuple[FileFormat, ...]:
+    """The plugins' formats (:func:`_plugin_formats`), loaded once a process."""
+    return tuple(_plugin_formats())
+
+
 def _installed() -> tuple[FileFormat, ...]:
-    """Built-in formats then plugins, loaded once a process."""
-    return (*BUILT_IN, *_plugin_formats())
+    """Built-in formats then plugins."""
+    return (*BUILT_IN, *_plugins())
 
 
 def registered_formats() -> tuple[FileFormat, ...]:
@@ -353,7 +386,10 @@ def format_named(name: str) -> FileFormat:
     thermocal.errors.ParameterError
         No format has that name (the registered ones are listed).
     """
-    for fmt in _installed():
+    for fmt in BUILT_IN:  # a built-in name needs no look at the installed packages
+        if fmt.name == name:
+            return fmt
+    for fmt in _plugins():
         if fmt.name == name:
             return fmt
     names = ", ".join(f.name for f in _installed())
@@ -362,7 +398,7 @@ def format_named(name: str) -> FileFormat:
 
 def _unknown_format_message(path: str | Path) -> str:
     """What to say of a file no registered format reads."""
-    plugins = [f for f in _installed() if f not in BUILT_IN and f.suffixes]
+    plugins = [f for f in _plugins() if f.suffixes]
     more = "".join(f", {', '.join(f.suffixes)} for {f.title}" for f in plugins)
     return (
         f"{path}: not a CSV or Parquet file (expected extension .csv, or .txt, .log, .tsv, "
@@ -373,7 +409,9 @@ def _unknown_format_message(path: str | Path) -> str:
 
 def format_of(path: str | Path) -> FileFormat:
     """The format of a file: the first registered format whose sniff function recognises the
-    path, else the one whose suffix ends its name (the longest that matches).
+    path, else the one whose suffix ends its name (the longest that matches).  The built-in
+    formats are tried first, sniff then suffix; the installed packages' formats (their
+    metadata read once) only for a path no built-in format recognises.
 
     Parameters
     ----------
@@ -398,28 +436,43 @@ def format_of(path: str | Path) -> FileFormat:
     ('a PX4 log', 'csv')
     """
     p = Path(path)
-    for fmt in _installed():
+    for fmt in BUILT_IN:
+        if fmt.sniff is not None and fmt.sniff(p):
+            return fmt
+    name = str(path).lower()
+    built_in = None if name.endswith(TEMP_SUFFIX) else _longest_suffix(name, BUILT_IN)
+    if built_in is not None:
+        return built_in
+    for fmt in _plugins():
         if fmt.sniff is not None and fmt.sniff(p):
             return fmt
     return _by_suffix(path)
 
 
+def _longest_suffix(name: str, formats: tuple[FileFormat, ...]) -> FileFormat | None:
+    """The format among ``formats`` whose suffix (the longest that matches) ends ``name``
+    (lower-case), or None."""
+    best: tuple[int, FileFormat] | None = None
+    for fmt in formats:
+        for s in fmt.suffixes:
+            if name.endswith(s) and (best is None or len(s) > best[0]):
+                best = (len(s), fmt)
+    return None if best is None else best[1]
+
+
 def _by_suffix(path: str | Path) -> FileFormat:
-    """The registered format whose suffix (the longest that matches) ends ``path``'s name."""
+    """The registered format whose suffix (the longest that matches) ends ``path``'s name: a
+    built-in one, else a plugin's (the installed packages looked at only then)."""
     name = str(path).lower()
     if name.endswith(TEMP_SUFFIX):
         raise FileFormatError(
             f"{path}: an unfinished output of an interrupted thermocal run, not a result; "
             "delete it (the next run to the same output removes it)"
         )
-    best: tuple[int, FileFormat] | None = None
-    for fmt in _installed():
-        for s in fmt.suffixes:
-            if name.endswith(s) and (best is None or len(s) > best[0]):
-                best = (len(s), fmt)
-    if best is None:
+    found = _longest_suffix(name, BUILT_IN) or _longest_suffix(name, _plugins())
+    if found is None:
         raise FileFormatError(_unknown_format_message(path))
-    return best[1]
+    return found
 
 
 def file_kind(path: str | Path) -> str:
