@@ -68,6 +68,7 @@ Frequency Stability Analysis*, NIST SP 1065 (2008); IEEE Std 1554-2005.
 from __future__ import annotations
 
 import dataclasses
+import functools
 import math
 import os
 from concurrent.futures import ThreadPoolExecutor
@@ -1312,9 +1313,180 @@ def nnls_small(a: FloatArray, b: FloatArray) -> FloatArray:
     return best
 
 
+_COV_EXACT: Final = 64
+"""A stretch of lags between two kinks of the summand shorter than this is summed lag by lag;
+a longer one by Gauss–Legendre quadrature with the Euler–Maclaurin end correction."""
+
+_COV_NODES: Final = 16
+"""Gauss–Legendre nodes per longer stretch of lags."""
+
+_COV_REACH: Final = 6
+"""Flicker FM's second differences correlate at every lag (∝ 1/l²): summed to this many
+times the longer τ beyond the windows' overlap."""
+
+
+def _phase_gacv(t_s: FloatArray, coef: FloatArray) -> FloatArray:
+    """The generalised autocovariance of the phase at lags ``t_s`` [s] for ``σ² = Σ C_p τ^p``
+    (white PM C₋₂ left out: :func:`_pair_sum` adds its δ exactly)."""
+    a = np.abs(t_s)
+    flicker = a * a * np.log(a, out=np.zeros_like(a), where=a > 0)
+    return np.asarray(
+        -0.5 * coef[1] * a + coef[2] / (4.0 * math.log(2.0)) * flicker + coef[3] / 4.0 * a**3,
+        dtype=np.float64,
+    )
+
+
+@functools.cache
+def _gauss_legendre() -> tuple[FloatArray, FloatArray]:
+    """The :data:`_COV_NODES` Gauss–Legendre nodes and weights on [−1, 1], computed once."""
+    x, w = np.polynomial.legendre.leggauss(_COV_NODES)
+    return np.asarray(x, dtype=np.float64), np.asarray(w, dtype=np.float64)
+
+
+def _lag_rule(knots: FloatArray) -> tuple[FloatArray, FloatArray]:
+    """Points and weights whose weighted sum of f is Σ_{l=knots[0]}^{knots[-1]} f(l), f
+    smooth between the integer ``knots``: lag by lag over short stretches, Gauss–Legendre
+    plus the Euler–Maclaurin end terms (f(a) − f(b))/2 over long ones."""
+    x, w = _gauss_legendre()
+    pts: list[FloatArray] = []
+    wts: list[FloatArray] = []
+    for a, b in zip(knots[:-1], knots[1:], strict=True):
+        if b - a <= _COV_EXACT:
+            pts.append(np.arange(a, b, dtype=np.float64))
+            wts.append(np.ones(int(b - a)))
+        else:
+            pts.append(np.concatenate([(a + b) / 2.0 + (b - a) / 2.0 * x, [a, b]]))
+            wts.append(np.concatenate([(b - a) / 2.0 * w, [0.5, -0.5]]))
+    pts.append(knots[-1:])
+    wts.append(np.ones(1))
+    return np.concatenate(pts), np.concatenate(wts)
+
+
+def _pair_sum(m1: int, m2: int, n1: float, n2: float, tau0_s: float, coef: FloatArray) -> float:
+    """Σ_l count(l)·(2c(l)² + 4μ₁μ₂·c(l)) of :func:`avar_covariance` for one pair m1 ≤ m2."""
+    d = (np.array([0, m1, 2 * m1])[:, None] - np.array([0, m2, 2 * m2])[None, :]).ravel()
+    wq = np.outer([1.0, -2.0, 1.0], [1.0, -2.0, 1.0]).ravel()
+    reach = _COV_REACH * m2 if coef[2] > 0 else 0
+    lo, hi = -2 * m2 - reach, 2 * m1 + reach
+    tails = np.array([1.0, 2.0, 4.0]) * m2 if reach else np.zeros(0)
+    knots = np.concatenate([d, -2 * m2 - tails, 2 * m1 + tails, [lo, hi, -n1, n2]])
+    knots = np.unique(np.clip(np.round(knots), lo, hi))
+    lag, weight = _lag_rule(knots)
+    ramp = 8.0 * coef[4] * (m1 * tau0_s) ** 2 * (m2 * tau0_s) ** 2  # 4μ₁μ₂, μ = Rτ²
+
+    def count(lg: FloatArray) -> FloatArray:
+        return np.clip(np.minimum(n1, n2 - lg) - np.maximum(0.0, -lg), 0.0, None)
+
+    c = _phase_gacv((d[None, :] - lag[:, None]) * tau0_s, coef) @ wq
+    total = float((weight * count(lag)) @ (2.0 * c * c + ramp * c))
+    if coef[0] > 0:  # white PM: a δ at the lags where two phase points coincide
+        pm_lag, where = np.unique(d, return_inverse=True)
+        pm = pm_lag.astype(np.float64)
+        c_pm = np.bincount(where.ravel(), weights=wq) * coef[0] / 3.0
+        c_o = _phase_gacv((d[None, :] - pm[:, None]) * tau0_s, coef) @ wq
+        total += float(count(pm) @ (2.0 * (2.0 * c_o * c_pm + c_pm**2) + ramp * c_pm))
+    return total
+
+
+def avar_covariance(
+    m: npt.ArrayLike, n_terms: npt.ArrayLike, tau0_s: float, coef: npt.ArrayLike
+) -> FloatArray:
+    r"""Covariance matrix of overlapping Allan variance estimates at several τ, for Gaussian
+    noise of Allan variance ``σ²(τ) = Σ_{p=−2..2} C_p τ^p``.
+
+    The points of one record share its data: neighbouring octave points are correlated
+    (about 0.5 for white FM, 0.7 flicker FM, 0.9 random-walk FM), which a fit that weights
+    them as independent does not see.  Each estimate is a mean of squared second differences
+    ``d_k = x_{k+2m} − 2x_{k+m} + x_k`` of the phase; for Gaussian noise (Isserlis)
+    ``cov(d_k², d'_j²) = 2c² + 4μμ'c`` with ``c = cov(d_k, d'_j)`` and μ the differences'
+    mean (a rate ramp's ``Rτ²``), and c follows from the phase's generalised autocovariance
+    ``s(t)``, which second differences see alone (they cancel polynomials of degree one):
+    ``c = Σ_{a,b} w_a w_b s(t_a − t_b)``, w = (1, −2, 1), with ``s(t) = (C₋₂/3)·δ(t)``
+    (white PM), ``−C₋₁|t|/2`` (white FM), ``C₀ t² ln|t| / (4 ln 2)`` (flicker FM),
+    ``C₁|t|³/4`` (random-walk FM), each giving its term of ``σ²(τ)`` exactly.  The lags
+    between two kinks of the summand are summed one by one or, over longer stretches, by
+    Gauss–Legendre quadrature (:func:`_lag_rule`); flicker's infinite reach is cut at
+    :data:`_COV_REACH` times the longer τ.  Gaps are ignored (one segment of ``n_terms``
+    differences per τ).
+
+    Parameters
+    ----------
+    m : array_like of int
+        Averaging factors of the points [samples].
+    n_terms : array_like
+        Second differences behind each point (N − 2m) [1].
+    tau0_s : float
+        Sample interval τ0 [s].
+    coef : array_like
+        The five coefficients C₋₂ … C₂ of ``σ²(τ)`` [unit²·s^−p], non-negative.
+
+    Returns
+    -------
+    numpy.ndarray
+        Covariance of the Allan variances, shape (len(m), len(m)) [unit⁴].
+
+    Notes
+    -----
+    .. math::
+
+        \operatorname{cov}(\hat\sigma^2_m, \hat\sigma^2_{m'}) =
+        \frac{\sum_l n(l)\,\bigl(2c_{mm'}(l)^2 + 4\mu_m\mu_{m'}c_{mm'}(l)\bigr)}
+             {4\tau_m^2\tau_{m'}^2 M M'}
+
+    with n(l) the pairs (k, k + l) of the M and M' differences.
+
+    References
+    ----------
+    - C. A. Greenhall and W. J. Riley, "Uncertainty of stability variances based on finite
+      differences", PTTI 2003 (the generalised autocovariance of the power-law noises).
+    - L. Isserlis, "On a formula for the product-moment coefficient of any order of a normal
+      frequency distribution in any number of variables", *Biometrika* 12 (1918) 134–139.
+    """
+    mm = np.asarray(m, dtype=np.int64)
+    nt = np.asarray(n_terms, dtype=np.float64)
+    c = np.maximum(np.asarray(coef, dtype=np.float64), 0.0)
+    out = np.zeros((mm.size, mm.size))
+    for i in range(mm.size):
+        for j in range(i, mm.size):
+            lo, hi = (i, j) if mm[i] <= mm[j] else (j, i)
+            s = _pair_sum(int(mm[lo]), int(mm[hi]), nt[lo], nt[hi], tau0_s, c)
+            t2 = (float(mm[i]) * tau0_s) ** 2 * (float(mm[j]) * tau0_s) ** 2
+            out[i, j] = out[j, i] = s / (4.0 * t2 * nt[i] * nt[j])
+    return out
+
+
 def _usable(result: AllanResult) -> npt.NDArray[np.bool_]:
     """The ADEV points noise terms can use: finite, above zero, with degrees of freedom."""
     return np.asarray(np.isfinite(result.adev) & (result.adev > 0) & (result.edf > 0))
+
+
+def _fit_sigma(
+    aw: FloatArray,
+    w: FloatArray,
+    active: npt.NDArray[np.bool_],
+    cov_s2: FloatArray,
+    red_chi2: float,
+) -> FloatArray:
+    """Standard errors of the fitted coefficients (NaN where inactive or inseparable).
+
+    The weighted estimate on the active columns is linear in the Allan variances,
+    ``Ĉ = B σ̂²`` with ``B = (AᵀWA)⁻¹AᵀW``; its covariance is ``B V Bᵀ`` with V the
+    Allan variances' own covariance (:func:`avar_covariance`, neighbouring points
+    correlated), not the ``(AᵀWA)⁻¹`` that independent points would give; scaled by the
+    reduced χ² when it exceeds 1 (a model that misses something).  ``aw`` the design
+    times the weights ``w`` (per point), from a QR factor of its scaled columns."""
+    sigma = np.full(5, np.nan)
+    if not active.any():
+        return sigma
+    a_act = aw[:, active]
+    col = np.linalg.norm(a_act, axis=0)
+    q, r = np.linalg.qr(a_act / col)
+    if not np.all(np.abs(np.diag(r)) > 1e-12 * np.abs(r).max()):
+        return sigma
+    b = np.linalg.solve(r, q.T) * w[None, :] / col[:, None]  # (AᵀWA)⁻¹AᵀW, back substitution
+    cov = b @ cov_s2 @ b.T * max(red_chi2, 1.0)
+    sigma[active] = np.sqrt(np.maximum(np.diag(cov), 0.0))
+    return sigma
 
 
 def _fit(
@@ -1355,15 +1527,8 @@ def _fit(
     active = coef > 0
     dof = max(tau.size - int(active.sum()), 1)
     red_chi2 = float(resid @ resid / dof)
-    sigma = np.full(5, np.nan)
-    if active.any():
-        a_act = aw[:, active]
-        col = np.linalg.norm(a_act, axis=0)
-        _q, r = np.linalg.qr(a_act / col)
-        if np.all(np.abs(np.diag(r)) > 1e-12 * np.abs(r).max()):
-            r_inv = np.linalg.solve(r, np.eye(r.shape[0]))  # back substitution
-            cov = (r_inv @ r_inv.T) / np.outer(col, col) * max(red_chi2, 1.0)
-            sigma[active] = np.sqrt(np.diag(cov))
+    cov_s2 = avar_covariance(result.m[ok], result.n_terms[ok], result.tau0_s, coef)
+    sigma = _fit_sigma(aw, w, active, cov_s2, red_chi2)
     reasons: list[str | None] = []
     for j in range(5):
         if coef[j] <= 0:
@@ -2041,6 +2206,7 @@ __all__ = [
     "NoiseTerms",
     "WhiteStretch",
     "annotate_periodic",
+    "avar_covariance",
     "averaging_factors",
     "bias_at_minimum",
     "confidence_interval",
