@@ -1315,7 +1315,7 @@ def nnls_small(a: FloatArray, b: FloatArray) -> FloatArray:
 
 _COV_EXACT: Final = 64
 """A stretch of lags between two kinks of the summand shorter than this is summed lag by lag;
-a longer one by Gauss–Legendre quadrature with the Euler–Maclaurin end correction."""
+a longer one by Gauss–Legendre quadrature with the Euler–Maclaurin end corrections."""
 
 _COV_NODES: Final = 16
 """Gauss–Legendre nodes per longer stretch of lags."""
@@ -1327,7 +1327,7 @@ times the longer τ beyond the windows' overlap."""
 
 def _phase_gacv(t_s: FloatArray, coef: FloatArray) -> FloatArray:
     """The generalised autocovariance of the phase at lags ``t_s`` [s] for ``σ² = Σ C_p τ^p``
-    (white PM C₋₂ left out: :func:`_pair_sum` adds its δ exactly)."""
+    (white PM C₋₂ left out: :func:`avar_covariance` adds its δ exactly)."""
     a = np.abs(t_s)
     flicker = a * a * np.log(a, out=np.zeros_like(a), where=a > 0)
     return np.asarray(
@@ -1343,49 +1343,65 @@ def _gauss_legendre() -> tuple[FloatArray, FloatArray]:
     return np.asarray(x, dtype=np.float64), np.asarray(w, dtype=np.float64)
 
 
-def _lag_rule(knots: FloatArray) -> tuple[FloatArray, FloatArray]:
-    """Points and weights whose weighted sum of f is Σ_{l=knots[0]}^{knots[-1]} f(l), f
-    smooth between the integer ``knots``: lag by lag over short stretches, Gauss–Legendre
-    plus the Euler–Maclaurin end terms (f(a) − f(b))/2 over long ones."""
-    x, w = _gauss_legendre()
-    pts: list[FloatArray] = []
-    wts: list[FloatArray] = []
-    for a, b in zip(knots[:-1], knots[1:], strict=True):
-        if b - a <= _COV_EXACT:
-            pts.append(np.arange(a, b, dtype=np.float64))
-            wts.append(np.ones(int(b - a)))
-        else:
-            pts.append(np.concatenate([(a + b) / 2.0 + (b - a) / 2.0 * x, [a, b]]))
-            wts.append(np.concatenate([(b - a) / 2.0 * w, [0.5, -0.5]]))
-    pts.append(knots[-1:])
-    wts.append(np.ones(1))
-    return np.concatenate(pts), np.concatenate(wts)
+_EM_ENDS: Final = np.array([15.0, -4.0, 1.0, -9.0, -4.0, 1.0]) / 24.0
+"""Weights of f(a), f(a+1), f(a+2), f(b), f(b−1), f(b−2) in Σ_{l=a}^{b−1} f(l) − ∫_a^b f: the
+Euler–Maclaurin terms (f(a) − f(b))/2 + (f′(b) − f′(a))/12, one-sided differences for f′."""
+
+_OFF_A: Final = np.repeat(np.array([0, 1, 2]), 3)
+_OFF_B: Final = np.tile(np.array([0, 1, 2]), 3)
+_W_AB: Final = np.outer([1.0, -2.0, 1.0], [1.0, -2.0, 1.0]).ravel()
+"""The nine phase offsets (a·m, b·m') of two second differences and their weights w_a·w_b."""
 
 
-def _pair_sum(m1: int, m2: int, n1: float, n2: float, tau0_s: float, coef: FloatArray) -> float:
-    """Σ_l count(l)·(2c(l)² + 4μ₁μ₂·c(l)) of :func:`avar_covariance` for one pair m1 ≤ m2."""
-    d = (np.array([0, m1, 2 * m1])[:, None] - np.array([0, m2, 2 * m2])[None, :]).ravel()
-    wq = np.outer([1.0, -2.0, 1.0], [1.0, -2.0, 1.0]).ravel()
-    reach = _COV_REACH * m2 if coef[2] > 0 else 0
+def _pair_knots(m1: int, m2: int, n1: float, n2: float, flicker: bool) -> list[int]:
+    """The lags where the summand of one pair m1 ≤ m2 has a kink, from the first to the last
+    lag summed (the nine offsets, the counts' corners, flicker's tail)."""
+    reach = _COV_REACH * m2 if flicker else 0
     lo, hi = -2 * m2 - reach, 2 * m1 + reach
-    tails = np.array([1.0, 2.0, 4.0]) * m2 if reach else np.zeros(0)
-    knots = np.concatenate([d, -2 * m2 - tails, 2 * m1 + tails, [lo, hi, -n1, n2]])
-    knots = np.unique(np.clip(np.round(knots), lo, hi))
-    lag, weight = _lag_rule(knots)
-    ramp = 8.0 * coef[4] * (m1 * tau0_s) ** 2 * (m2 * tau0_s) ** 2  # 4μ₁μ₂, μ = Rτ²
+    knots = {a * m1 - b * m2 for a in range(3) for b in range(3)} | {lo, hi}
+    knots |= {-int(n1), int(n2)}
+    if flicker:
+        knots |= {-2 * m2 - f * m2 for f in (1, 2, 4)} | {2 * m1 + f * m2 for f in (1, 2, 4)}
+    return sorted(k for k in knots if lo <= k <= hi)
 
-    def count(lg: FloatArray) -> FloatArray:
-        return np.clip(np.minimum(n1, n2 - lg) - np.maximum(0.0, -lg), 0.0, None)
 
-    c = _phase_gacv((d[None, :] - lag[:, None]) * tau0_s, coef) @ wq
-    total = float((weight * count(lag)) @ (2.0 * c * c + ramp * c))
-    if coef[0] > 0:  # white PM: a δ at the lags where two phase points coincide
-        pm_lag, where = np.unique(d, return_inverse=True)
-        pm = pm_lag.astype(np.float64)
-        c_pm = np.bincount(where.ravel(), weights=wq) * coef[0] / 3.0
-        c_o = _phase_gacv((d[None, :] - pm[:, None]) * tau0_s, coef) @ wq
-        total += float(count(pm) @ (2.0 * (2.0 * c_o * c_pm + c_pm**2) + ramp * c_pm))
-    return total
+def _lag_points(
+    m: IntArray, n_terms: FloatArray, flicker: bool
+) -> tuple[IntArray, IntArray, FloatArray, FloatArray]:
+    """For every pair (i ≤ j) of points, the lags and weights whose weighted sum of a summand
+    smooth between the pair's knots (:func:`_pair_knots`) is its sum over every integer lag:
+    lag by lag over stretches of at most :data:`_COV_EXACT`, Gauss–Legendre plus the
+    Euler–Maclaurin end terms (:data:`_EM_ENDS`) over longer ones.  Returns the pairs' (i, j),
+    each point's pair and the points' lags and weights."""
+    ii, jj = np.triu_indices(m.size)
+    short: list[tuple[int, int, int]] = []
+    long: list[tuple[int, int, int]] = []
+    last = np.empty(ii.size)
+    for p, (i, j) in enumerate(zip(ii.tolist(), jj.tolist(), strict=True)):
+        lo_i, hi_i = (i, j) if m[i] <= m[j] else (j, i)
+        knots = _pair_knots(int(m[lo_i]), int(m[hi_i]), n_terms[lo_i], n_terms[hi_i], flicker)
+        for a, b in zip(knots[:-1], knots[1:], strict=True):
+            (short if b - a <= _COV_EXACT else long).append((a, b, p))
+        last[p] = knots[-1]
+    sa, sb, sp = (np.array(v, dtype=np.int64).reshape(-1) for v in zip(*short, strict=True))
+    n_s = sb - sa
+    start = np.repeat(np.cumsum(n_s) - n_s, n_s)
+    lag_s = np.repeat(sa, n_s) + np.arange(int(n_s.sum())) - start
+    pair = [np.repeat(sp, n_s), np.arange(ii.size)]
+    lags = [lag_s.astype(np.float64), last]
+    wts = [np.ones(lag_s.size), np.ones(ii.size)]
+    if long:
+        la, lb, lp = (np.array(v, dtype=np.float64) for v in zip(*long, strict=True))
+        x, w = _gauss_legendre()
+        half = (lb - la)[:, None] / 2.0
+        ends = np.concatenate([la[:, None] + [0.0, 1.0, 2.0], lb[:, None] - [0.0, 1.0, 2.0]], 1)
+        pts = np.concatenate([(la + lb)[:, None] / 2.0 + half * x, ends], 1)
+        wt = np.concatenate([half * w, np.broadcast_to(_EM_ENDS, (la.size, 6))], 1)
+        pair.append(np.repeat(lp.astype(np.int64), x.size + 6))
+        lags.append(pts.ravel())
+        wts.append(wt.ravel())
+    pair_ij = np.column_stack([ii, jj])
+    return pair_ij, np.concatenate(pair), np.concatenate(lags), np.concatenate(wts)
 
 
 def avar_covariance(
@@ -1405,7 +1421,7 @@ def avar_covariance(
     (white PM), ``−C₋₁|t|/2`` (white FM), ``C₀ t² ln|t| / (4 ln 2)`` (flicker FM),
     ``C₁|t|³/4`` (random-walk FM), each giving its term of ``σ²(τ)`` exactly.  The lags
     between two kinks of the summand are summed one by one or, over longer stretches, by
-    Gauss–Legendre quadrature (:func:`_lag_rule`); flicker's infinite reach is cut at
+    Gauss–Legendre quadrature (:func:`_lag_points`); flicker's infinite reach is cut at
     :data:`_COV_REACH` times the longer τ.  Gaps are ignored (one segment of ``n_terms``
     differences per τ).
 
@@ -1445,13 +1461,32 @@ def avar_covariance(
     mm = np.asarray(m, dtype=np.int64)
     nt = np.asarray(n_terms, dtype=np.float64)
     c = np.maximum(np.asarray(coef, dtype=np.float64), 0.0)
+    pair_ij, pid, lag, wt = _lag_points(mm, nt, bool(c[2] > 0))
+    i, j = pair_ij[:, 0], pair_ij[:, 1]
+    swap = mm[i] > mm[j]
+    first, second = np.where(swap, j, i), np.where(swap, i, j)  # m1 ≤ m2
+    m1, m2 = mm[first].astype(np.float64), mm[second].astype(np.float64)
+    n1, n2 = nt[first], nt[second]
+    ramp = 8.0 * c[4] * (m1 * tau0_s) ** 2 * (m2 * tau0_s) ** 2  # 4μ₁μ₂, μ = Rτ²
+
+    def count(lg: FloatArray, a: FloatArray, b: FloatArray) -> FloatArray:
+        return np.clip(np.minimum(a, b - lg) - np.maximum(0.0, -lg), 0.0, None)
+
+    d = _OFF_A[None, :] * m1[pid, None] - _OFF_B[None, :] * m2[pid, None]
+    cc = _phase_gacv((d - lag[:, None]) * tau0_s, c) @ _W_AB
+    f = wt * count(lag, n1[pid], n2[pid]) * (2.0 * cc * cc + ramp[pid] * cc)
+    total = np.bincount(pid, weights=f, minlength=i.size)
+    if c[0] > 0:  # white PM: a δ at the lags where two phase points coincide
+        dp = _OFF_A[None, :] * m1[:, None] - _OFF_B[None, :] * m2[:, None]
+        same = dp[:, :, None] == dp[:, None, :]
+        c_pm = (same * _W_AB).sum(axis=2) * c[0] / 3.0
+        c_o = _phase_gacv((dp[:, None, :] - dp[:, :, None]) * tau0_s, c) @ _W_AB
+        g = count(dp, n1[:, None], n2[:, None]) / same.sum(axis=2)  # each lag once
+        total += np.sum(g * (2.0 * (2.0 * c_o * c_pm + c_pm**2) + ramp[:, None] * c_pm), axis=1)
+    tau = mm.astype(np.float64) * tau0_s
     out = np.zeros((mm.size, mm.size))
-    for i in range(mm.size):
-        for j in range(i, mm.size):
-            lo, hi = (i, j) if mm[i] <= mm[j] else (j, i)
-            s = _pair_sum(int(mm[lo]), int(mm[hi]), nt[lo], nt[hi], tau0_s, c)
-            t2 = (float(mm[i]) * tau0_s) ** 2 * (float(mm[j]) * tau0_s) ** 2
-            out[i, j] = out[j, i] = s / (4.0 * t2 * nt[i] * nt[j])
+    out[i, j] = total / (4.0 * tau[i] ** 2 * tau[j] ** 2 * nt[i] * nt[j])
+    out[j, i] = out[i, j]
     return out
 
 
@@ -1489,6 +1524,27 @@ def _fit_sigma(
     return sigma
 
 
+def _irls(
+    design: FloatArray, s2: FloatArray, edf: FloatArray, cols: npt.NDArray[np.bool_]
+) -> tuple[FloatArray, FloatArray, FloatArray]:
+    """Weighted NNLS of ``s2`` on the columns ``cols`` of ``design``, weights
+    ``√(edf/2)/σ²`` iterated three times with the fitted σ² in place of the noisy σ̂²;
+    the coefficients (zero outside ``cols``), the weighted design and the weights."""
+    model = s2.copy()
+    coef = np.zeros(5)
+    for _ in range(3):
+        w = np.sqrt(edf / 2.0) / model
+        aw = design[:, cols] * w[:, None]
+        scale = np.linalg.norm(aw, axis=0)
+        scale[scale == 0] = 1.0
+        coef = np.zeros(5)
+        coef[cols] = nnls_small(aw / scale, s2 * w) / scale
+        fitted = design @ coef
+        model = np.where(fitted > 0, fitted, s2)
+    w = np.sqrt(edf / 2.0) / model
+    return coef, design * w[:, None], w
+
+
 def _fit(
     result: AllanResult, significance: float, ok: npt.NDArray[np.bool_] | None = None
 ) -> tuple[FloatArray, FloatArray, float, list[str | None], FitQuality | None]:
@@ -1508,30 +1564,32 @@ def _fit(
     if tau.size == 0:  # a constant or too short signal: no point to fit
         why = "no Allan deviation point above zero (a constant or too short signal)"
         return np.zeros(5), np.full(5, np.nan), float("nan"), [why] * 5, None
-    powers = np.arange(-2, 3, dtype=np.float64)
-    design = tau[:, None] ** powers[None, :]
-    model = s2.copy()
-    coef = np.zeros(5)
-    for _ in range(3):
-        w = np.sqrt(edf / 2.0) / model
-        aw = design * w[:, None]
-        scale = np.linalg.norm(aw, axis=0)
-        scale[scale == 0] = 1.0
-        sol = nnls_small(aw / scale, s2 * w)
-        coef = sol / scale
-        fitted = design @ coef
-        model = np.where(fitted > 0, fitted, s2)
-    w = np.sqrt(edf / 2.0) / model
-    aw = design * w[:, None]
-    resid = aw @ coef - s2 * w
-    active = coef > 0
-    dof = max(tau.size - int(active.sum()), 1)
-    red_chi2 = float(resid @ resid / dof)
-    cov_s2 = avar_covariance(result.m[ok], result.n_terms[ok], result.tau0_s, coef)
-    sigma = _fit_sigma(aw, w, active, cov_s2, red_chi2)
+    design = tau[:, None] ** np.arange(-2, 3, dtype=np.float64)[None, :]
+    cols = np.ones(5, dtype=bool)
+    dropped: dict[int, tuple[float, float]] = {}
+    while True:
+        coef, aw, w = _irls(design, s2, edf, cols)
+        resid = aw @ coef - s2 * w
+        active = coef > 0
+        red_chi2 = float(resid @ resid / max(tau.size - int(active.sum()), 1))
+        cov_s2 = avar_covariance(result.m[ok], result.n_terms[ok], result.tau0_s, coef)
+        sigma = _fit_sigma(aw, w, active, cov_s2, red_chi2)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            ratio = np.where(active & (coef < significance * sigma), coef / sigma, np.inf)
+        if not np.isfinite(ratio).any() or int(active.sum()) <= 1 or red_chi2 > POOR_CHI2:
+            break  # all significant, the last term, or a model that does not hold anyway
+        j = int(np.argmin(ratio))  # the least significant term leaves the model
+        dropped[j] = (float(coef[j]), float(sigma[j]))
+        cols[j] = False
     reasons: list[str | None] = []
     for j in range(5):
-        if coef[j] <= 0:
+        if j in dropped:
+            reasons.append(
+                f"not significant: fitted coefficient {dropped[j][0]:.3g} ± "
+                f"{dropped[j][1]:.2g} is below {significance:g} standard errors (left out "
+                "of the fit)"
+            )
+        elif coef[j] <= 0:
             reasons.append("the non-negative least-squares fit sets this term to zero")
         elif not np.isfinite(sigma[j]):
             reasons.append("the fit cannot separate this term from the others")
