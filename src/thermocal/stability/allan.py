@@ -69,6 +69,7 @@ from __future__ import annotations
 
 import dataclasses
 import functools
+import itertools
 import math
 import os
 from concurrent.futures import ThreadPoolExecutor
@@ -1380,7 +1381,7 @@ def _lag_points(
     for p, (i, j) in enumerate(zip(ii.tolist(), jj.tolist(), strict=True)):
         lo_i, hi_i = (i, j) if m[i] <= m[j] else (j, i)
         knots = _pair_knots(int(m[lo_i]), int(m[hi_i]), n_terms[lo_i], n_terms[hi_i], flicker)
-        for a, b in zip(knots[:-1], knots[1:], strict=True):
+        for a, b in itertools.pairwise(knots):
             (short if b - a <= _COV_EXACT else long).append((a, b, p))
         last[p] = knots[-1]
     sa, sb, sp = (np.array(v, dtype=np.int64).reshape(-1) for v in zip(*short, strict=True))
@@ -1470,7 +1471,7 @@ def avar_covariance(
     ramp = 8.0 * c[4] * (m1 * tau0_s) ** 2 * (m2 * tau0_s) ** 2  # 4μ₁μ₂, μ = Rτ²
 
     def count(lg: FloatArray, a: FloatArray, b: FloatArray) -> FloatArray:
-        return np.clip(np.minimum(a, b - lg) - np.maximum(0.0, -lg), 0.0, None)
+        return np.asarray(np.clip(np.minimum(a, b - lg) - np.maximum(0.0, -lg), 0.0, None))
 
     d = _OFF_A[None, :] * m1[pid, None] - _OFF_B[None, :] * m2[pid, None]
     cc = _phase_gacv((d - lag[:, None]) * tau0_s, c) @ _W_AB
@@ -1551,9 +1552,12 @@ def _fit(
     """Weighted NNLS of σ²(τ) = Σ_{p=−2..2} C_p τ^p (IEEE 952 C.2).
 
     Weights 1/sd(σ̂²) with sd(σ̂²) = σ² √(2/edf) (chi-square with edf degrees of
-    freedom), iterated three times with the fitted σ² in place of the noisy σ̂²;
-    standard errors from the QR factor of the weighted active design, scaled by
-    the reduced χ² when it exceeds 1.  Returns C, sd(C), reduced χ², reasons and the
+    freedom), iterated three times with the fitted σ² in place of the noisy σ̂²
+    (:func:`_irls`); standard errors from the Allan variances' covariance across τ
+    (:func:`_fit_sigma`, :func:`avar_covariance`), scaled by the reduced χ² when it
+    exceeds 1.  While the model fits (reduced χ² ≤ :data:`POOR_CHI2`) and more than one
+    term remains, the least significant term below ``significance`` standard errors is
+    left out and the fit repeated.  Returns C, sd(C), reduced χ², reasons and the
     fit's quality (:func:`fit_quality`; None without points).  ``ok``: the points
     used (default :func:`_usable`).
     """
@@ -2128,9 +2132,11 @@ def noise_terms(
     Fit (IEEE 952 C.2): ``σ²(τ) = Σ_{p=−2..2} C_p τ^p`` by weighted NNLS
     (see :func:`_fit`); ``Q = √(C₋₂/3)``, ``N = √C₋₁``, ``B = √(C₀ π/(2 ln 2))``,
     ``K = √(3C₁)``, ``R = √(2C₂)``.  A coefficient that is zero or below
-    ``significance`` standard errors is reported as ``None`` with a reason.
+    ``significance`` standard errors is reported as ``None`` with a reason (and left out
+    of the fit, which is repeated without it, while the model fits).
     Interval: ``C ± z·sd(C)`` (z the normal quantile of ``confidence``), mapped
-    through the square root.
+    through the square root; sd(C) from the covariance of the Allan variances across τ
+    (:func:`avar_covariance`: neighbouring points share data).
 
     Slope lines (IEEE 952 C.3): for slope s ∈ {−1, 0, +½, +1} the region of
     that slope is the run of points whose weighted local slope (ln σ against ln τ
