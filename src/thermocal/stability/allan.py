@@ -1384,7 +1384,7 @@ def _lag_points(
         for a, b in itertools.pairwise(knots):
             (short if b - a <= _COV_EXACT else long).append((a, b, p))
         last[p] = knots[-1]
-    sa, sb, sp = (np.array(v, dtype=np.int64).reshape(-1) for v in zip(*short, strict=True))
+    sa, sb, sp = np.array(short, dtype=np.int64).reshape(-1, 3).T
     n_s = sb - sa
     start = np.repeat(np.cumsum(n_s) - n_s, n_s)
     lag_s = np.repeat(sa, n_s) + np.arange(int(n_s.sum())) - start
@@ -1392,7 +1392,7 @@ def _lag_points(
     lags = [lag_s.astype(np.float64), last]
     wts = [np.ones(lag_s.size), np.ones(ii.size)]
     if long:
-        la, lb, lp = (np.array(v, dtype=np.float64) for v in zip(*long, strict=True))
+        la, lb, lp = np.array(long, dtype=np.float64).reshape(-1, 3).T
         x, w = _gauss_legendre()
         half = (lb - la)[:, None] / 2.0
         ends = np.concatenate([la[:, None] + [0.0, 1.0, 2.0], lb[:, None] - [0.0, 1.0, 2.0]], 1)
@@ -1571,12 +1571,14 @@ def _fit(
     design = tau[:, None] ** np.arange(-2, 3, dtype=np.float64)[None, :]
     cols = np.ones(5, dtype=bool)
     dropped: dict[int, tuple[float, float]] = {}
+    cov_s2: FloatArray | None = None  # of the full model while choosing, the final one after
     while True:
         coef, aw, w = _irls(design, s2, edf, cols)
         resid = aw @ coef - s2 * w
         active = coef > 0
         red_chi2 = float(resid @ resid / max(tau.size - int(active.sum()), 1))
-        cov_s2 = avar_covariance(result.m[ok], result.n_terms[ok], result.tau0_s, coef)
+        if cov_s2 is None:
+            cov_s2 = avar_covariance(result.m[ok], result.n_terms[ok], result.tau0_s, coef)
         sigma = _fit_sigma(aw, w, active, cov_s2, red_chi2)
         with np.errstate(invalid="ignore", divide="ignore"):
             ratio = np.where(active & (coef < significance * sigma), coef / sigma, np.inf)
@@ -1585,6 +1587,9 @@ def _fit(
         j = int(np.argmin(ratio))  # the least significant term leaves the model
         dropped[j] = (float(coef[j]), float(sigma[j]))
         cols[j] = False
+    if dropped:  # the standard errors of the model kept
+        cov_s2 = avar_covariance(result.m[ok], result.n_terms[ok], result.tau0_s, coef)
+        sigma = _fit_sigma(aw, w, active, cov_s2, red_chi2)
     reasons: list[str | None] = []
     for j in range(5):
         if j in dropped:
