@@ -1314,7 +1314,7 @@ def nnls_small(a: FloatArray, b: FloatArray) -> FloatArray:
     return best
 
 
-_COV_EXACT: Final = 64
+_COV_EXACT: Final = 24
 """A stretch of lags between two kinks of the summand shorter than this is summed lag by lag;
 a longer one by Gauss–Legendre quadrature with the Euler–Maclaurin end corrections."""
 
