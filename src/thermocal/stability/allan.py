@@ -2138,10 +2138,8 @@ def noise_terms(
     (see :func:`_fit`); ``Q = √(C₋₂/3)``, ``N = √C₋₁``, ``B = √(C₀ π/(2 ln 2))``,
     ``K = √(3C₁)``, ``R = √(2C₂)``.  A coefficient that is zero or below
     ``significance`` standard errors is reported as ``None`` with a reason (and left out
-    of the fit, which is repeated without it, while the model fits).
-    Interval: ``C ± z·sd(C)`` (z the normal quantile of ``confidence``), mapped
-    through the square root; sd(C) from the covariance of the Allan variances across τ
-    (:func:`avar_covariance`: neighbouring points share data).
+    of the fit, :func:`_fit`).  Interval: ``C ± z·sd(C)`` (z the normal quantile of
+    ``confidence``; sd from :func:`avar_covariance`), mapped through the square root.
 
     Slope lines (IEEE 952 C.3): for slope s ∈ {−1, 0, +½, +1} the region of
     that slope is the run of points whose weighted local slope (ln σ against ln τ
