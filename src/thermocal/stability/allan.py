@@ -69,6 +69,7 @@ from __future__ import annotations
 
 import dataclasses
 import functools
+import itertools
 import math
 import os
 from collections.abc import Callable
@@ -1377,9 +1378,236 @@ def nnls_small(a: FloatArray, b: FloatArray) -> FloatArray:
     return best
 
 
+_COV_EXACT: Final = 24
+"""A stretch of lags between two kinks of the summand shorter than this is summed lag by lag;
+a longer one by Gauss–Legendre quadrature with the Euler–Maclaurin end corrections."""
+
+_COV_NODES: Final = 16
+"""Gauss–Legendre nodes per longer stretch of lags."""
+
+_COV_REACH: Final = 6
+"""Flicker FM's second differences correlate at every lag (∝ 1/l²): summed to this many
+times the longer τ beyond the windows' overlap."""
+
+
+def _phase_gacv(t_s: FloatArray, coef: FloatArray) -> FloatArray:
+    """The generalised autocovariance of the phase at lags ``t_s`` [s] for ``σ² = Σ C_p τ^p``
+    (white PM C₋₂ left out: :func:`avar_covariance` adds its δ exactly)."""
+    a = np.abs(t_s)
+    flicker = a * a * np.log(a, out=np.zeros_like(a), where=a > 0)
+    return np.asarray(
+        -0.5 * coef[1] * a + coef[2] / (4.0 * math.log(2.0)) * flicker + coef[3] / 4.0 * a**3,
+        dtype=np.float64,
+    )
+
+
+@functools.cache
+def _gauss_legendre() -> tuple[FloatArray, FloatArray]:
+    """The :data:`_COV_NODES` Gauss–Legendre nodes and weights on [−1, 1], computed once."""
+    x, w = np.polynomial.legendre.leggauss(_COV_NODES)
+    return np.asarray(x, dtype=np.float64), np.asarray(w, dtype=np.float64)
+
+
+_EM_ENDS: Final = np.array([15.0, -4.0, 1.0, -9.0, -4.0, 1.0]) / 24.0
+"""Weights of f(a), f(a+1), f(a+2), f(b), f(b−1), f(b−2) in Σ_{l=a}^{b−1} f(l) − ∫_a^b f: the
+Euler–Maclaurin terms (f(a) − f(b))/2 + (f′(b) − f′(a))/12, one-sided differences for f′."""
+
+_OFF_A: Final = np.repeat(np.array([0, 1, 2]), 3)
+_OFF_B: Final = np.tile(np.array([0, 1, 2]), 3)
+_W_AB: Final = np.outer([1.0, -2.0, 1.0], [1.0, -2.0, 1.0]).ravel()
+"""The nine phase offsets (a·m, b·m') of two second differences and their weights w_a·w_b."""
+
+
+def _pair_knots(m1: int, m2: int, n1: float, n2: float, flicker: bool) -> list[int]:
+    """The lags where the summand of one pair m1 ≤ m2 has a kink, from the first to the last
+    lag summed (the nine offsets, the counts' corners, flicker's tail)."""
+    reach = _COV_REACH * m2 if flicker else 0
+    lo, hi = -2 * m2 - reach, 2 * m1 + reach
+    knots = {a * m1 - b * m2 for a in range(3) for b in range(3)} | {lo, hi}
+    knots |= {-int(n1), int(n2)}
+    if flicker:
+        knots |= {-2 * m2 - f * m2 for f in (1, 2, 4)} | {2 * m1 + f * m2 for f in (1, 2, 4)}
+    return sorted(k for k in knots if lo <= k <= hi)
+
+
+def _lag_points(
+    m: IntArray, n_terms: FloatArray, flicker: bool
+) -> tuple[IntArray, IntArray, FloatArray, FloatArray]:
+    """For every pair (i ≤ j) of points, the lags and weights whose weighted sum of a summand
+    smooth between the pair's knots (:func:`_pair_knots`) is its sum over every integer lag:
+    lag by lag over stretches of at most :data:`_COV_EXACT`, Gauss–Legendre plus the
+    Euler–Maclaurin end terms (:data:`_EM_ENDS`) over longer ones.  Returns the pairs' (i, j),
+    each point's pair and the points' lags and weights."""
+    ii, jj = np.triu_indices(m.size)
+    short: list[tuple[int, int, int]] = []
+    long: list[tuple[int, int, int]] = []
+    last = np.empty(ii.size)
+    for p, (i, j) in enumerate(zip(ii.tolist(), jj.tolist(), strict=True)):
+        lo_i, hi_i = (i, j) if m[i] <= m[j] else (j, i)
+        knots = _pair_knots(int(m[lo_i]), int(m[hi_i]), n_terms[lo_i], n_terms[hi_i], flicker)
+        for a, b in itertools.pairwise(knots):
+            (short if b - a <= _COV_EXACT else long).append((a, b, p))
+        last[p] = knots[-1]
+    sa, sb, sp = np.array(short, dtype=np.int64).reshape(-1, 3).T
+    n_s = sb - sa
+    start = np.repeat(np.cumsum(n_s) - n_s, n_s)
+    lag_s = np.repeat(sa, n_s) + np.arange(int(n_s.sum())) - start
+    pair = [np.repeat(sp, n_s), np.arange(ii.size)]
+    lags = [lag_s.astype(np.float64), last]
+    wts = [np.ones(lag_s.size), np.ones(ii.size)]
+    if long:
+        la, lb, lp = np.array(long, dtype=np.float64).reshape(-1, 3).T
+        x, w = _gauss_legendre()
+        half = (lb - la)[:, None] / 2.0
+        ends = np.concatenate([la[:, None] + [0.0, 1.0, 2.0], lb[:, None] - [0.0, 1.0, 2.0]], 1)
+        pts = np.concatenate([(la + lb)[:, None] / 2.0 + half * x, ends], 1)
+        wt = np.concatenate([half * w, np.broadcast_to(_EM_ENDS, (la.size, 6))], 1)
+        pair.append(np.repeat(lp.astype(np.int64), x.size + 6))
+        lags.append(pts.ravel())
+        wts.append(wt.ravel())
+    pair_ij = np.column_stack([ii, jj])
+    return pair_ij, np.concatenate(pair), np.concatenate(lags), np.concatenate(wts)
+
+
+def avar_covariance(
+    m: npt.ArrayLike, n_terms: npt.ArrayLike, tau0_s: float, coef: npt.ArrayLike
+) -> FloatArray:
+    r"""Covariance matrix of overlapping Allan variance estimates at several τ, for Gaussian
+    noise of Allan variance ``σ²(τ) = Σ_{p=−2..2} C_p τ^p``.
+
+    The points of one record share its data: neighbouring octave points are correlated
+    (about 0.5 for white FM, 0.7 flicker FM, 0.9 random-walk FM), which a fit that weights
+    them as independent does not see.  Each estimate is a mean of squared second differences
+    ``d_k = x_{k+2m} − 2x_{k+m} + x_k`` of the phase; for Gaussian noise (Isserlis)
+    ``cov(d_k², d'_j²) = 2c² + 4μμ'c`` with ``c = cov(d_k, d'_j)`` and μ the differences'
+    mean (a rate ramp's ``Rτ²``), and c follows from the phase's generalised autocovariance
+    ``s(t)``, which second differences see alone (they cancel polynomials of degree one):
+    ``c = Σ_{a,b} w_a w_b s(t_a − t_b)``, w = (1, −2, 1), with ``s(t) = (C₋₂/3)·δ(t)``
+    (white PM), ``−C₋₁|t|/2`` (white FM), ``C₀ t² ln|t| / (4 ln 2)`` (flicker FM),
+    ``C₁|t|³/4`` (random-walk FM), each giving its term of ``σ²(τ)`` exactly.  The lags
+    between two kinks of the summand are summed one by one or, over longer stretches, by
+    Gauss–Legendre quadrature (:func:`_lag_points`); flicker's infinite reach is cut at
+    :data:`_COV_REACH` times the longer τ.  Gaps are ignored (one segment of ``n_terms``
+    differences per τ).
+
+    Parameters
+    ----------
+    m : array_like of int
+        Averaging factors of the points [samples].
+    n_terms : array_like
+        Second differences behind each point (N − 2m) [1].
+    tau0_s : float
+        Sample interval τ0 [s].
+    coef : array_like
+        The five coefficients C₋₂ … C₂ of ``σ²(τ)`` [unit²·s^−p], non-negative.
+
+    Returns
+    -------
+    numpy.ndarray
+        Covariance of the Allan variances, shape (len(m), len(m)) [unit⁴].
+
+    Notes
+    -----
+    .. math::
+
+        \operatorname{cov}(\hat\sigma^2_m, \hat\sigma^2_{m'}) =
+        \frac{\sum_l n(l)\,\bigl(2c_{mm'}(l)^2 + 4\mu_m\mu_{m'}c_{mm'}(l)\bigr)}
+             {4\tau_m^2\tau_{m'}^2 M M'}
+
+    with n(l) the pairs (k, k + l) of the M and M' differences.
+
+    References
+    ----------
+    - C. A. Greenhall and W. J. Riley, "Uncertainty of stability variances based on finite
+      differences", PTTI 2003 (the generalised autocovariance of the power-law noises).
+    - L. Isserlis, "On a formula for the product-moment coefficient of any order of a normal
+      frequency distribution in any number of variables", *Biometrika* 12 (1918) 134–139.
+    """
+    mm = np.asarray(m, dtype=np.int64)
+    nt = np.asarray(n_terms, dtype=np.float64)
+    c = np.maximum(np.asarray(coef, dtype=np.float64), 0.0)
+    pair_ij, pid, lag, wt = _lag_points(mm, nt, bool(c[2] > 0))
+    i, j = pair_ij[:, 0], pair_ij[:, 1]
+    swap = mm[i] > mm[j]
+    first, second = np.where(swap, j, i), np.where(swap, i, j)  # m1 ≤ m2
+    m1, m2 = mm[first].astype(np.float64), mm[second].astype(np.float64)
+    n1, n2 = nt[first], nt[second]
+    ramp = 8.0 * c[4] * (m1 * tau0_s) ** 2 * (m2 * tau0_s) ** 2  # 4μ₁μ₂, μ = Rτ²
+
+    def count(lg: FloatArray, a: FloatArray, b: FloatArray) -> FloatArray:
+        return np.asarray(np.clip(np.minimum(a, b - lg) - np.maximum(0.0, -lg), 0.0, None))
+
+    d = _OFF_A[None, :] * m1[pid, None] - _OFF_B[None, :] * m2[pid, None]
+    cc = _phase_gacv((d - lag[:, None]) * tau0_s, c) @ _W_AB
+    f = wt * count(lag, n1[pid], n2[pid]) * (2.0 * cc * cc + ramp[pid] * cc)
+    total = np.bincount(pid, weights=f, minlength=i.size)
+    if c[0] > 0:  # white PM: a δ at the lags where two phase points coincide
+        dp = _OFF_A[None, :] * m1[:, None] - _OFF_B[None, :] * m2[:, None]
+        same = dp[:, :, None] == dp[:, None, :]
+        c_pm = (same * _W_AB).sum(axis=2) * c[0] / 3.0
+        c_o = _phase_gacv((dp[:, None, :] - dp[:, :, None]) * tau0_s, c) @ _W_AB
+        g = count(dp, n1[:, None], n2[:, None]) / same.sum(axis=2)  # each lag once
+        total += np.sum(g * (2.0 * (2.0 * c_o * c_pm + c_pm**2) + ramp[:, None] * c_pm), axis=1)
+    tau = mm.astype(np.float64) * tau0_s
+    out = np.zeros((mm.size, mm.size))
+    out[i, j] = total / (4.0 * tau[i] ** 2 * tau[j] ** 2 * nt[i] * nt[j])
+    out[j, i] = out[i, j]
+    return out
+
+
 def _usable(result: AllanResult) -> npt.NDArray[np.bool_]:
     """The ADEV points noise terms can use: finite, above zero, with degrees of freedom."""
     return np.asarray(np.isfinite(result.adev) & (result.adev > 0) & (result.edf > 0))
+
+
+def _fit_sigma(
+    aw: FloatArray,
+    w: FloatArray,
+    active: npt.NDArray[np.bool_],
+    cov_s2: FloatArray,
+    red_chi2: float,
+) -> FloatArray:
+    """Standard errors of the fitted coefficients (NaN where inactive or inseparable).
+
+    The weighted estimate on the active columns is linear in the Allan variances,
+    ``Ĉ = B σ̂²`` with ``B = (AᵀWA)⁻¹AᵀW``; its covariance is ``B V Bᵀ`` with V the
+    Allan variances' own covariance (:func:`avar_covariance`, neighbouring points
+    correlated), not the ``(AᵀWA)⁻¹`` that independent points would give; scaled by the
+    reduced χ² when it exceeds 1 (a model that misses something).  ``aw`` the design
+    times the weights ``w`` (per point), from a QR factor of its scaled columns."""
+    sigma = np.full(5, np.nan)
+    if not active.any():
+        return sigma
+    a_act = aw[:, active]
+    col = np.linalg.norm(a_act, axis=0)
+    q, r = np.linalg.qr(a_act / col)
+    if not np.all(np.abs(np.diag(r)) > 1e-12 * np.abs(r).max()):
+        return sigma
+    b = np.linalg.solve(r, q.T) * w[None, :] / col[:, None]  # (AᵀWA)⁻¹AᵀW, back substitution
+    cov = b @ cov_s2 @ b.T * max(red_chi2, 1.0)
+    sigma[active] = np.sqrt(np.maximum(np.diag(cov), 0.0))
+    return sigma
+
+
+def _irls(
+    design: FloatArray, s2: FloatArray, edf: FloatArray, cols: npt.NDArray[np.bool_]
+) -> tuple[FloatArray, FloatArray, FloatArray]:
+    """Weighted NNLS of ``s2`` on the columns ``cols`` of ``design``, weights
+    ``√(edf/2)/σ²`` iterated three times with the fitted σ² in place of the noisy σ̂²;
+    the coefficients (zero outside ``cols``), the weighted design and the weights."""
+    model = s2.copy()
+    coef = np.zeros(5)
+    for _ in range(3):
+        w = np.sqrt(edf / 2.0) / model
+        aw = design[:, cols] * w[:, None]
+        scale = np.linalg.norm(aw, axis=0)
+        scale[scale == 0] = 1.0
+        coef = np.zeros(5)
+        coef[cols] = nnls_small(aw / scale, s2 * w) / scale
+        fitted = design @ coef
+        model = np.where(fitted > 0, fitted, s2)
+    w = np.sqrt(edf / 2.0) / model
+    return coef, design * w[:, None], w
 
 
 def _fit(
@@ -1388,9 +1616,12 @@ def _fit(
     """Weighted NNLS of σ²(τ) = Σ_{p=−2..2} C_p τ^p (IEEE 952 C.2).
 
     Weights 1/sd(σ̂²) with sd(σ̂²) = σ² √(2/edf) (chi-square with edf degrees of
-    freedom), iterated three times with the fitted σ² in place of the noisy σ̂²;
-    standard errors from the QR factor of the weighted active design, scaled by
-    the reduced χ² when it exceeds 1.  Returns C, sd(C), reduced χ², reasons and the
+    freedom), iterated three times with the fitted σ² in place of the noisy σ̂²
+    (:func:`_irls`); standard errors from the Allan variances' covariance across τ
+    (:func:`_fit_sigma`, :func:`avar_covariance`), scaled by the reduced χ² when it
+    exceeds 1.  While the model fits (reduced χ² ≤ :data:`POOR_CHI2`) and more than one
+    term remains, the least significant term below ``significance`` standard errors is
+    left out and the fit repeated.  Returns C, sd(C), reduced χ², reasons and the
     fit's quality (:func:`fit_quality`; None without points).  ``ok``: the points
     used (default :func:`_usable`).
     """
@@ -1401,37 +1632,37 @@ def _fit(
     if tau.size == 0:  # a constant or too short signal: no point to fit
         why = "no Allan deviation point above zero (a constant or too short signal)"
         return np.zeros(5), np.full(5, np.nan), float("nan"), [why] * 5, None
-    powers = np.arange(-2, 3, dtype=np.float64)
-    design = tau[:, None] ** powers[None, :]
-    model = s2.copy()
-    coef = np.zeros(5)
-    for _ in range(3):
-        w = np.sqrt(edf / 2.0) / model
-        aw = design * w[:, None]
-        scale = np.linalg.norm(aw, axis=0)
-        scale[scale == 0] = 1.0
-        sol = nnls_small(aw / scale, s2 * w)
-        coef = sol / scale
-        fitted = design @ coef
-        model = np.where(fitted > 0, fitted, s2)
-    w = np.sqrt(edf / 2.0) / model
-    aw = design * w[:, None]
-    resid = aw @ coef - s2 * w
-    active = coef > 0
-    dof = max(tau.size - int(active.sum()), 1)
-    red_chi2 = float(resid @ resid / dof)
-    sigma = np.full(5, np.nan)
-    if active.any():
-        a_act = aw[:, active]
-        col = np.linalg.norm(a_act, axis=0)
-        _q, r = np.linalg.qr(a_act / col)
-        if np.all(np.abs(np.diag(r)) > 1e-12 * np.abs(r).max()):
-            r_inv = np.linalg.solve(r, np.eye(r.shape[0]))  # back substitution
-            cov = (r_inv @ r_inv.T) / np.outer(col, col) * max(red_chi2, 1.0)
-            sigma[active] = np.sqrt(np.diag(cov))
+    design = tau[:, None] ** np.arange(-2, 3, dtype=np.float64)[None, :]
+    cols = np.ones(5, dtype=bool)
+    dropped: dict[int, tuple[float, float]] = {}
+    cov_s2: FloatArray | None = None  # of the full model while choosing, the final one after
+    while True:
+        coef, aw, w = _irls(design, s2, edf, cols)
+        resid = aw @ coef - s2 * w
+        active = coef > 0
+        red_chi2 = float(resid @ resid / max(tau.size - int(active.sum()), 1))
+        if cov_s2 is None:
+            cov_s2 = avar_covariance(result.m[ok], result.n_terms[ok], result.tau0_s, coef)
+        sigma = _fit_sigma(aw, w, active, cov_s2, red_chi2)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            ratio = np.where(active & (coef < significance * sigma), coef / sigma, np.inf)
+        if not np.isfinite(ratio).any() or int(active.sum()) <= 1 or red_chi2 > POOR_CHI2:
+            break  # all significant, the last term, or a model that does not hold anyway
+        j = int(np.argmin(ratio))  # the least significant term leaves the model
+        dropped[j] = (float(coef[j]), float(sigma[j]))
+        cols[j] = False
+    if dropped:  # the standard errors of the model kept
+        cov_s2 = avar_covariance(result.m[ok], result.n_terms[ok], result.tau0_s, coef)
+        sigma = _fit_sigma(aw, w, active, cov_s2, red_chi2)
     reasons: list[str | None] = []
     for j in range(5):
-        if coef[j] <= 0:
+        if j in dropped:
+            reasons.append(
+                f"not significant: fitted coefficient {dropped[j][0]:.3g} ± "
+                f"{dropped[j][1]:.2g} is below {significance:g} standard errors (left out "
+                "of the fit)"
+            )
+        elif coef[j] <= 0:
             reasons.append("the non-negative least-squares fit sets this term to zero")
         elif not np.isfinite(sigma[j]):
             reasons.append("the fit cannot separate this term from the others")
@@ -1970,9 +2201,9 @@ def noise_terms(
     Fit (IEEE 952 C.2): ``σ²(τ) = Σ_{p=−2..2} C_p τ^p`` by weighted NNLS
     (see :func:`_fit`); ``Q = √(C₋₂/3)``, ``N = √C₋₁``, ``B = √(C₀ π/(2 ln 2))``,
     ``K = √(3C₁)``, ``R = √(2C₂)``.  A coefficient that is zero or below
-    ``significance`` standard errors is reported as ``None`` with a reason.
-    Interval: ``C ± z·sd(C)`` (z the normal quantile of ``confidence``), mapped
-    through the square root.
+    ``significance`` standard errors is reported as ``None`` with a reason (and left out
+    of the fit, :func:`_fit`).  Interval: ``C ± z·sd(C)`` (z the normal quantile of
+    ``confidence``; sd from :func:`avar_covariance`), mapped through the square root.
 
     Slope lines (IEEE 952 C.3): for slope s ∈ {−1, 0, +½, +1} the region of
     that slope is the run of points whose weighted local slope (ln σ against ln τ
@@ -2106,6 +2337,7 @@ __all__ = [
     "NoiseTerms",
     "WhiteStretch",
     "annotate_periodic",
+    "avar_covariance",
     "averaging_factors",
     "bias_at_minimum",
     "confidence_interval",
