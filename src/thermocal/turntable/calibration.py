@@ -634,14 +634,6 @@ def calibrate(
     )  # fmt: skip
 
 
-ISOTROPIC_NOTE = (
-    "the g-sensitivity is c·I alone (c = {c:.3g} ± {s:.2g} °/h/g): what a vertical earth "
-    "rate off by c gives (a latitude of the wrong sign), so it is not taken off the moves; "
-    "check the latitude"
-)
-"""Why an isotropic ``A`` (:func:`.gsens.isotropic_part`) is reported but not subtracted."""
-
-
 def _estimate_channels(
     channels: int,
     arw: FloatArray,
@@ -681,7 +673,9 @@ def _g_sensitivity(
         gs = fit(est)
     except DesignError as exc:
         return est, (None, str(exc), False)
-    iso = gsens_mod.isotropic_part(gs)
+    from thermocal.multipos.gsens import ISOTROPIC_NOTE, isotropic_part
+
+    iso = isotropic_part(gs.matrix_deg_h_g, gs.sigma_deg_h_g)
     if iso is not None:
         return est, (gs, ISOTROPIC_NOTE.format(c=iso[0], s=iso[1]), False)
     if not bool(np.any(gs.significant)):
