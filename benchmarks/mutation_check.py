@@ -4954,6 +4954,38 @@ MUTANTS: tuple[Mutant, ...] = (
         _t("multipos_isotropic"),
         "a wrong latitude's A = c·I stored in the calibration and applied by compensate",
     ),
+    Mutant(
+        "text-k2-rows-dropped",
+        P + "report/triad_text.py",
+        "    if k2:\n",
+        "    if not k2:\n",
+        _t("report_triad_text_k2"),
+        "the accelerometer's table without the K2 the calibration stores",
+    ),
+    Mutant(
+        "text-misfit-nine-parameter",
+        P + "report/triad_text.py",
+        'if "accel_k2" in run else (run["accel"], "")',
+        'if "accel_k2" not in run else (run["accel"], "")',
+        _t("report_triad_text_k2"),
+        "the misfit of the nine-parameter fit said beside a calibration fitted with K2",
+    ),
+    Mutant(
+        "mp-summary-nine-parameter-residual",
+        P + "pipeline/multipos.py",
+        "        stored = _accel_fit(run)  # the fit the calibration holds (with K2 when fitted)",
+        "        stored = run.result.accel",
+        _t("report_triad_text_k2"),
+        "the summary's residual after from the fit without K2 while the file stores K2's",
+    ),
+    Mutant(
+        "text-gsens-no-star",
+        P + "report/triad_text.py",
+        '        star = " *" if s > 0 and abs(v) > SIGNIFICANT_SIGMA * s else ""',
+        '        star = ""',
+        _t("report_triad_text_k2"),
+        "no element of the g-sensitivity table marked beyond 3σ",
+    ),
 )
 
 

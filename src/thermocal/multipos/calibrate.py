@@ -318,6 +318,10 @@ class SessionResult:
         return pandas.DataFrame(self.table())
 
     def poses_dict(self) -> list[dict[str, Any]]:
+        """Each pose: name, start, end, mean specific force [mg], gravity-magnitude residual
+        [mg] of the accelerometer fit a calibration stores (with K2 when fitted) and the
+        still ratio."""
+        fit = self.accel if self.accel_k2 is None else self.accel_k2.linear
         return [
             {
                 "name": p.section.name,
@@ -327,7 +331,7 @@ class SessionResult:
                 "gravity_residual_mg": r,
                 "still_ratio": p.section.still_ratio,
             }
-            for p, r in zip(self.poses, self.accel.residuals_mg, strict=False)
+            for p, r in zip(self.poses, fit.residuals_mg, strict=False)
         ]
 
 

@@ -911,8 +911,9 @@ def _summary(
                           "g_sensitivity_subtracted": r.g_sensitivity_subtracted}  # fmt: skip
         if run.accel_k2 is not None:
             rd["accel_k2"] = run.accel_k2.to_dict(to_a, a_unit)
-        all_before.append(r.accel.residual_rms_before_mg**2 * len(r.poses))
-        all_after.append(r.accel.residual_rms_after_mg**2 * len(r.poses))
+        stored = _accel_fit(run)  # the fit the calibration holds (with K2 when fitted)
+        all_before.append(stored.residual_rms_before_mg**2 * len(r.poses))
+        all_after.append(stored.residual_rms_after_mg**2 * len(r.poses))
         run_dicts.append(rd)
     n_poses = sum(len(run.result.poses) for run in runs)
     out["n_poses"] = n_poses
