@@ -4986,6 +4986,14 @@ MUTANTS: tuple[Mutant, ...] = (
         _t("report_triad_text_k2"),
         "no element of the g-sensitivity table marked beyond 3σ",
     ),
+    Mutant(
+        "tt-soaks-store-when-none-took-it-off",
+        P + "pipeline/turntable.py",
+        "    if runs and taken == len(runs):",
+        "    if runs and taken >= 0:",
+        _t("report_triad_text_turntable", "turntable_gsens"),
+        "the soaks' pooled A stored though no run took it off (their biases then hold it)",
+    ),
 )
 
 

@@ -366,7 +366,12 @@ def turntable_text(res: SingleRunResult) -> list[Block]:
         f"filter/LS agreement {fmt(out['agreement_max_sigma'], 2)} σ; written {res.output}",
     ]
     line = turntable_g_sensitivity_line(out, str(res.input))
-    return blocks + ([line] if line is not None else [])
+    blocks += [line] if line is not None else []
+    gs = out.get("g_sensitivity")
+    if gs is not None:  # this run's estimate (°/h/g, as the result's JSON holds it)
+        state = "taken off the moves" if out.get("g_sensitivity_subtracted") else "not taken off"
+        blocks.append(g_sensitivity_table(gs, f"gyro g-sensitivity from the dwells, {state}"))
+    return blocks
 
 
 def turntable_g_sensitivity_line(out: dict[str, Any], name: str) -> str | None:
@@ -431,6 +436,13 @@ def turntable_thermal_text(res: ThermalRunsResult) -> list[Block]:
     for f, r in res.runs:
         line = turntable_g_sensitivity_line(r.to_dict(), str(f))
         blocks += [line] if line is not None else []
+    gs = res.g_sensitivity
+    if gs:
+        blocks.append(f"gyro g-sensitivity over the soaks {gs['why']}"
+                      + ("" if gs["stored"] else ": compensate leaves it in"))  # fmt: skip
+        if gs["matrix"] is not None:
+            state = "stored" if gs["stored"] else "not stored"
+            blocks.append(g_sensitivity_table(gs, f"gyro g-sensitivity over the soaks, {state}"))
     blocks.append(f"calibration written: {res.output} (compensate applies it per sample)")
     return blocks
 
