@@ -4853,8 +4853,8 @@ MUTANTS: tuple[Mutant, ...] = (
     Mutant(
         "turntable-validate-g-sensitivity",
         P + "turntable/thermal.py",
-        "xc = correct(triad, x if g_term is None else x - g_term, temp_c, bias_to_data)",
-        "xc = correct(triad, x, temp_c, bias_to_data)",
+        "    xg = x if g_term is None else x - g_term\n",
+        "    xg = x\n",
         _t("turntable_gsens"),
         "validate of a turntable calibration leaves the gyro's A f in the dwell means",
     ),
@@ -4993,6 +4993,14 @@ MUTANTS: tuple[Mutant, ...] = (
         "    if runs and taken >= 0:",
         _t("report_triad_text_turntable", "turntable_gsens"),
         "the soaks' pooled A stored though no run took it off (their biases then hold it)",
+    ),
+    Mutant(
+        "tt-validate-k2-left-out",
+        P + "turntable/thermal.py",
+        "if compensate is None else compensate(xg, temp_c)",
+        "if True else compensate(xg, temp_c)",
+        _t("turntable_validate_k2"),
+        "a turntable validation judging an accelerometer without the K2 its calibration stores",
     ),
 )
 
