@@ -708,6 +708,22 @@ def _gyro_fit(
     return gfit
 
 
+def _gyro_stage(
+    t: FloatArray, a: FloatArray, w: FloatArray, stats: Sequence[PoseStats],
+    turns: Sequence[Section], am: _AccelModel, g_mg: float, latitude_deg: float | None,
+    saturated: npt.ArrayLike | None, gyro_model: str, where: str, sections_from: str,
+) -> tuple[_gyro.GyroFit, _gsens.GSensitivity | None, str | None, bool]:  # fmt: skip
+    """The gyro's part of :func:`calibrate_session`: its g-sensitivity, the rates with
+    ``A f`` taken off when significant (:func:`_without_g_drift`), the rotations' fit; the
+    fit, the g-sensitivity, why (not), and whether it was taken off."""
+    sat = None if saturated is None else np.asarray(saturated, dtype=bool)
+    gsens, gnote = _g_sensitivity(stats, am, g_mg, latitude_deg)
+    w_fit, stats_fit, subtracted, gnote = _without_g_drift(a, w, stats, am, gsens, gnote)
+    gfit = _gyro_fit(t, a, w_fit, stats_fit, turns, am, g_mg, latitude_deg, sat,
+                     gyro_model, where, sections_from)  # fmt: skip
+    return gfit, gsens, gnote, subtracted
+
+
 def calibrate_session(
     time_s: npt.ArrayLike,
     accel_mg: npt.ArrayLike,
@@ -745,9 +761,8 @@ def calibrate_session(
     gyro_model : {"full", "scale"}, optional
         The elements of the gyro's ``E`` fitted (:data:`.gyro.GYRO_MODELS`).
     accel_k2 : bool, optional
-        Also fit each accelerometer axis's K2 (:func:`.accel_k2.fit_k2`); the gyro's up
-        directions, its g-sensitivity and the force taken off with it then read the
-        accelerometer with K2.
+        Also fit each accelerometer axis's K2 (:func:`.accel_k2.fit_k2`), which the gyro's
+        stage then reads the accelerometer with (up directions, g-sensitivity, A f).
 
     Returns
     -------
@@ -803,13 +818,9 @@ def calibrate_session(
     acc, idx = _accel_fit(stats, g_mg, where, sections_from)
     am, k2fit = _accel_model(stats, acc, idx, g_mg, accel_k2, where)
     temp = None if temperature_c is None else _mean_over(temperature_c, statics)
-    gfit, gsens, gnote, subtracted = None, None, None, False
-    if w is not None:
-        sat = None if saturated is None else np.asarray(saturated, dtype=bool)
-        gsens, gnote = _g_sensitivity(stats, am, g_mg, latitude_deg)
-        w_fit, stats_fit, subtracted, gnote = _without_g_drift(a, w, stats, am, gsens, gnote)
-        gfit = _gyro_fit(t, a, w_fit, stats_fit, turns, am, g_mg, latitude_deg, sat,
-                         gyro_model, where, sections_from)  # fmt: skip
+    gfit, gsens, gnote, subtracted = (None, None, None, False) if w is None else _gyro_stage(
+        t, a, w, stats, turns, am, g_mg, latitude_deg, saturated, gyro_model, where, sections_from
+    )  # fmt: skip
     return SessionResult(acc, gfit, tuple(stats), tuple(turns), g_mg, temp, not_still,
                          gsens, gnote, subtracted, k2fit)  # fmt: skip
 
