@@ -85,3 +85,16 @@ def test_a_gyro_alone_has_nothing_to_multiply(sessions: Path) -> None:
     with_a = dataclasses.replace(gyro, g_sensitivity=np.eye(3), g_sensitivity_sigma=None)
     cells = term_section(with_a, [with_a])["rows"][0]["cells"]  # type: ignore[index]
     assert [c["z"] for c in cells] == ["—"] * 3 and not any(c["beyond"] for c in cells)
+
+
+def test_the_reason_follows_the_calibrating_command(sessions: Path) -> None:
+    """A gyro beside an accelerometer without A: multipos' rule (3σ, not c·I alone, or
+    asked for) or the turntable soaks' (every soak took it off)."""
+    code, _o, err = run(["multipos", str(sessions / "s.csv"), *MULTIPOS, "-o",
+                         str(sessions / "off.json"), "--g-sensitivity", "off"])  # fmt: skip
+    assert code == 0, err
+    triads = load_calibration(sessions / "off.json").triads
+    gyro = next(t for t in triads if t.name == "gyro")
+    assert "not c·I alone" in (term_section(gyro, triads) or {})["absent"]
+    tt = dataclasses.replace(gyro, model=dataclasses.replace(gyro.model, method="turntable"))
+    assert "every soak's dwells" in (term_section(tt, [tt, *triads]) or {})["absent"]

@@ -167,10 +167,15 @@ def _absent_why(tri: Any, triads: Any) -> str:
         if not any(t.model.kind == "accel" for t in triads):
             return ("not estimated: the calibration holds no accelerometer triad, whose "
                     "specific force A multiplies")  # fmt: skip
-        return ("not stored in this calibration: A is stored when an element of the poses' "
-                "or dwells' estimate lies beyond 3σ, or when asked for (g_sensitivity "
-                "'apply'); the calibrating command's output gives the estimate. The "
-                "compensation leaves any g-sensitivity in the gyro's output")  # fmt: skip
+        when = (
+            "every soak's dwells found an element beyond 3σ and took it off"
+            if tri.model.method == "turntable"
+            else "an element of the poses' estimate lies beyond 3σ (not c·I alone), or "
+            "when asked for (g_sensitivity 'apply')"
+        )
+        return (f"not stored in this calibration: A is stored when {when}; the calibrating "
+                "command's output gives the estimate. The compensation leaves any "
+                "g-sensitivity in the gyro's output")  # fmt: skip
     if tri.model.method == "turntable":
         return ("not estimated: the turntable's accelerometer fit holds the bias, scale "
                 "factors and misalignments alone (the tumble test gives one axis's "
