@@ -37,15 +37,19 @@ def run(args: list[str]) -> tuple[int, str, str]:
     return code, o.getvalue(), e.getvalue()
 
 
-def write_session(folder: Path, seed: int = 5, a_deg_h_g: Any = A_TRUE) -> dict[str, Any]:
-    """The session simulated with ``a_deg_h_g`` and written to ``folder/s.csv``."""
-    s = simulate_session(np.random.default_rng(seed), ACCEL_THETA, GYRO_THETA, n_poses=16,
+def write_session(
+    folder: Path, seed: int = 5, a_deg_h_g: Any = A_TRUE, *, k2_mg_g2: Any = None,
+    name: str = "s.csv", n_poses: int = 16,
+) -> dict[str, Any]:  # fmt: skip
+    """The session simulated with ``a_deg_h_g`` (and the accelerometer's ``k2_mg_g2``
+    [mg per g²]) and written to ``folder/NAME``."""
+    s = simulate_session(np.random.default_rng(seed), ACCEL_THETA, GYRO_THETA, n_poses=n_poses,
                          gyro_noise_deg_s=GYRO_NOISE_DEG_S, latitude_deg=LATITUDE_DEG,
-                         g_sensitivity_deg_h_g=a_deg_h_g)  # fmt: skip
+                         g_sensitivity_deg_h_g=a_deg_h_g, accel_k2_mg_g2=k2_mg_g2)  # fmt: skip
     cols = {"t": s["time_s"]}
     cols.update({f"a{c}": s["accel_mg"][:, k] for k, c in enumerate("xyz")})
     cols.update({f"g{c}": s["gyro_deg_s"][:, k] for k, c in enumerate("xyz")})
-    pd.DataFrame(cols).to_csv(folder / "s.csv", index=False)
+    pd.DataFrame(cols).to_csv(folder / name, index=False)
     return s
 
 

@@ -175,7 +175,7 @@ def test_the_rotations_fit_takes_the_sensitivitys_drift_off(
     import thermocal.multipos.calibrate as calibrate_mod
 
     monkeypatch.setattr(calibrate_mod, "_without_g_drift",
-                        lambda a, w, stats, acc, gs: (w, list(stats), False))  # fmt: skip
+                        lambda a, w, st, am, gs, note: (w, list(st), False, note))  # fmt: skip
     left_in = [np.abs(_gyro_z(seed, A_LARGE)[0][3:6]).max() for seed in range(4)]
     assert min(left_in) > 3.0, left_in
 

@@ -202,7 +202,7 @@ def test_runs_over_temperature_state_each_runs_sensitivity(tmp_path: Path) -> No
         assert main([*args, str(tmp_path / "a.json")]) == 0
     with contextlib.redirect_stdout(js):
         assert main([*args, str(tmp_path / "b.json"), "--json"]) == 0
-    lines = [ln for ln in text.getvalue().splitlines() if "gyro g-sensitivity" in ln]
+    lines = [ln for ln in text.getvalue().splitlines() if "gyro g-sensitivity from" in ln]
     assert len(lines) == 3 and all("from 16 dwells" in ln for ln in lines), lines
     assert all("none beyond 3σ" in ln for ln in lines), lines
     runs = json.loads(js.getvalue())["runs"]

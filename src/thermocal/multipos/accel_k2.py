@@ -112,7 +112,8 @@ class AccelK2Fit:
         -------
         dict
             ``k2``, ``k2_sigma`` [unit/g²], ``unit``, ``significant`` (beyond 3σ),
-            ``residual_rms_after`` [unit], ``reduced_chi2``, ``n_poses``, and the linear
+            ``residual_rms_after`` [unit], ``reduced_chi2``, ``misfit`` (the τ added to each
+            pose's σ, 0 without) [unit], ``n_poses``, and the linear
             parameters fitted with it (``bias``, ``scale_factor_ppm``,
             ``misalignment_arcsec`` with their σ).
         """
@@ -126,6 +127,7 @@ class AccelK2Fit:
                             zip(self.k2_mg_per_g2, self.k2_sigma, strict=True)],
             "residual_rms_after": lin.residual_rms_after_mg * to_unit,
             "reduced_chi2": lin.reduced_chi2,
+            "misfit": lin.misfit_mg * to_unit,
             "n_poses": lin.n_poses,
             "bias": (lin.theta[0:3] * to_unit).tolist(),
             "bias_sigma": (s[0:3] * to_unit).tolist(),

@@ -32,6 +32,7 @@ import numpy.typing as npt
 from thermocal import units
 from thermocal.errors import DesignError, ThermocalInputError, ThermocalWarning
 from thermocal.multipos import accel as _accel
+from thermocal.multipos import accel_k2 as _accel_k2
 from thermocal.multipos import gsens as _gsens
 from thermocal.multipos import gyro as _gyro
 from thermocal.multipos.geometry import attitude_along
@@ -257,10 +258,14 @@ class SessionResult:
         (:func:`thermocal.multipos.gsens.fit_g_sensitivity`; None without a gyro or when the
         poses cannot separate it).
     g_sensitivity_note : str or None
-        Why it is None with a gyro (the poses it would need).
+        Why it is None with a gyro (the poses it would need), or why a significant one was
+        not taken off (``c·I`` alone: :func:`thermocal.multipos.gsens.isotropic_part`).
     g_sensitivity_subtracted : bool
         Whether an element of it was beyond 3σ and ``A f(t)`` was taken off the rates before
         the gyro's bias, scale factors and misalignments were fitted.
+    accel_k2 : AccelK2Fit or None
+        The accelerometer fitted with K2 per axis (``accel_k2``), whose force the gyro's
+        stage read; None without.
     """
 
     accel: _accel.AccelFit
@@ -273,6 +278,7 @@ class SessionResult:
     g_sensitivity: _gsens.GSensitivity | None = None
     g_sensitivity_note: str | None = None
     g_sensitivity_subtracted: bool = False
+    accel_k2: _accel_k2.AccelK2Fit | None = None
 
     def to_dict(self) -> dict[str, Any]:
         """The session's calibration as plain JSON types: ``accel`` and ``gyro``
@@ -312,6 +318,10 @@ class SessionResult:
         return pandas.DataFrame(self.table())
 
     def poses_dict(self) -> list[dict[str, Any]]:
+        """Each pose: name, start, end, mean specific force [mg], gravity-magnitude residual
+        [mg] of the accelerometer fit a calibration stores (with K2 when fitted) and the
+        still ratio."""
+        fit = self.accel if self.accel_k2 is None else self.accel_k2.linear
         return [
             {
                 "name": p.section.name,
@@ -321,27 +331,59 @@ class SessionResult:
                 "gravity_residual_mg": r,
                 "still_ratio": p.section.still_ratio,
             }
-            for p, r in zip(self.poses, self.accel.residuals_mg, strict=False)
+            for p, r in zip(self.poses, fit.residuals_mg, strict=False)
         ]
 
 
+def _calibrated_force(
+    theta: FloatArray, f_mg: FloatArray, k2: FloatArray | None = None, g_mg: float = 1.0
+) -> FloatArray:
+    """The calibrated specific force [mg] of readings ``f_mg`` (…, 3) with the
+    accelerometer parameters ``theta``: ``(I + E)⁻¹ (f − b)``, or with ``k2`` [mg/g², per
+    local g ``g_mg``] the ``a`` of ``f = (I + E) a + b + K2 ⊙ (a/g)²`` (:mod:`.accel_k2`)."""
+    e = model.error_matrices(theta)
+    if k2 is None:
+        out: FloatArray = np.asarray(np.linalg.solve(np.eye(3) + e, (f_mg - theta[0:3]).T).T)
+        return out
+    return _accel_k2._invert(f_mg, theta[0:3], e, k2, g_mg)
+
+
+@dataclass(frozen=True)
+class _AccelModel:
+    """The accelerometer the gyro's stage reads the specific force with: its fit, the
+    indices of θ that fit frees and, when fitted (``accel_k2``), each axis's K2 [mg/g²,
+    per local g], the force then the fixed point of :mod:`.accel_k2`."""
+
+    fit: _accel.AccelFit
+    idx: Sequence[int]
+    k2: FloatArray | None = None
+    g_mg: float = units.G_TO_MG
+
+    def force(self, f_mg: FloatArray) -> FloatArray:
+        """The calibrated specific force [mg] of readings ``f_mg`` (…, 3) at the fit's θ
+        (:func:`_calibrated_force`)."""
+        return _calibrated_force(self.fit.theta, f_mg, self.k2, self.g_mg)
+
+
 def _up_function(
-    theta: FloatArray, idx: Sequence[int], f_mg: FloatArray, held: FloatArray | None = None
-) -> Any:
+    theta: FloatArray, idx: Sequence[int], f_mg: FloatArray, held: FloatArray | None = None,
+    k2: FloatArray | None = None, g_mg: float = 1.0,
+) -> Any:  # fmt: skip
     """``p ↦`` unit up directions of the poses for the accelerometer parameters ``p`` at
     ``idx`` of θ (the others held).  The poses where ``held`` is true keep their direction
     at ``theta`` whatever ``p``: the faces of the six-face closed form, whose calibrated
     direction ``(I + Ê)⁻¹(f_j± − b̂) = ±g e_j + (f_j+ + f_j−)/2 − b̂`` (to first order)
     does not move with the calibration's error (E's column j is made of that very
-    pose's mean): their error is only the direction noise of :func:`_direction_sigma`."""
+    pose's mean): their error is only the direction noise of :func:`_direction_sigma`.
+    With ``k2`` [mg/g², per local g ``g_mg``] the force is read with it
+    (:func:`_calibrated_force`)."""
     base = theta.copy()
     ids = np.asarray(idx)
 
     def up_at(p: FloatArray) -> FloatArray:
         th = base.copy()
         th[ids] = p
-        e = model.error_matrices(th)
-        c = np.linalg.solve(np.eye(3) + e, (f_mg - th[0:3]).T).T
+        c = _calibrated_force(th, f_mg, k2, g_mg)
         out: FloatArray = c / np.linalg.norm(c, axis=1)[:, None]
         return out
 
@@ -377,7 +419,7 @@ def _named_turns(
     dt_s: FloatArray,
     bias_rad_s: FloatArray,
     accel_mg: FloatArray,
-    acc: _accel.AccelFit,
+    am: _AccelModel,
     face_sigma_rad: dict[str, float],
     where: str,
     sections_from: str,
@@ -391,8 +433,7 @@ def _named_turns(
     direction noise ``face_sigma_rad[face]`` (:func:`_direction_sigma`); without that
     face among the poses, the accelerometer calibration's σ of the two misalignments of
     column j (the frame is the accelerometer's)."""
-    e_a = model.error_matrices(acc.theta)
-    var = np.diag(acc.cov)
+    var = np.diag(am.fit.cov)
     out = []
     dt_med = float(np.median(dt_s))
     for tr in turns:
@@ -413,8 +454,7 @@ def _named_turns(
             )
         rot = _gyro.turn_rotation(rate_rad_s, dt_s, bias_rad_s, tr)
         _gyro.check_turn(rot, tr.name, j, f"{where} {tr.name!r}", sections_from)
-        c = np.linalg.solve(np.eye(3) + e_a, accel_mg[tr.start : tr.end].mean(axis=0)
-                            - acc.theta[0:3])  # fmt: skip
+        c = am.force(accel_mg[tr.start : tr.end].mean(axis=0)[None, :])[0]
         col = [6 + k for k, n in enumerate(model.MISALIGNMENT_NAMES)
                if model.MISALIGNMENT_INDEX[n][1] == j]  # fmt: skip
         face = f"{'xyz'[j]}_{'p' if c[j] >= 0 else 'a'}"
@@ -566,17 +606,16 @@ def _mean_over(x: npt.ArrayLike, sections: Sequence[Section]) -> float:
 
 
 def _calibrated_up(
-    stats: Sequence[PoseStats], acc: _accel.AccelFit, idx: Sequence[int]
+    stats: Sequence[PoseStats], am: _AccelModel
 ) -> tuple[Any, FloatArray, FloatArray]:
     """The up direction of each pose as a function of the accelerometer's free θ, those
-    θ and their covariance."""
+    θ and their covariance (K2, when fitted, held at its value)."""
+    acc, idx = am.fit, np.asarray(am.idx)
     f = np.asarray([p.f_mean_mg for p in stats])
     names = [p.section.name for p in stats]
     held = np.array([acc.method == "six-face" and n in FACES for n in names])
-    up_of = _up_function(acc.theta, idx, f, held)
-    free = acc.theta[np.asarray(idx)]
-    free_cov = acc.cov[np.ix_(np.asarray(idx), np.asarray(idx))]
-    return up_of, free, free_cov
+    up_of = _up_function(acc.theta, am.idx, f, held, am.k2, am.g_mg)
+    return up_of, acc.theta[idx], acc.cov[np.ix_(idx, idx)]
 
 
 def _pose_rates(stats: Sequence[PoseStats]) -> tuple[FloatArray, FloatArray, FloatArray]:
@@ -590,11 +629,10 @@ def _pose_rates(stats: Sequence[PoseStats]) -> tuple[FloatArray, FloatArray, Flo
 
 
 def _g_sensitivity(
-    stats: Sequence[PoseStats], acc: _accel.AccelFit, idx: Sequence[int], g_mg: float,
-    latitude_deg: float | None,
-) -> tuple[_gsens.GSensitivity | None, str | None]:  # fmt: skip
+    stats: Sequence[PoseStats], am: _AccelModel, g_mg: float, latitude_deg: float | None
+) -> tuple[_gsens.GSensitivity | None, str | None]:
     """The gyro's g-sensitivity from the static poses (:mod:`.gsens`), or None and why."""
-    up_of, free, _cov = _calibrated_up(stats, acc, idx)
+    up_of, free, _cov = _calibrated_up(stats, am)
     n, wm, ws = _pose_rates(stats)
     try:
         gs = _gsens.fit_g_sensitivity(wm, n, ws, up_of(free) * g_mg / 1000.0, latitude_deg)
@@ -604,38 +642,59 @@ def _g_sensitivity(
 
 
 def _without_g_drift(
-    a: FloatArray, w: FloatArray, stats: Sequence[PoseStats], acc: _accel.AccelFit,
-    gs: _gsens.GSensitivity | None,
-) -> tuple[FloatArray, list[PoseStats], bool]:  # fmt: skip
+    a: FloatArray, w: FloatArray, stats: Sequence[PoseStats], am: _AccelModel,
+    gs: _gsens.GSensitivity | None, note: str | None,
+) -> tuple[FloatArray, list[PoseStats], bool, str | None]:  # fmt: skip
     """The rates the rotations' fit takes: with an element of the g-sensitivity beyond 3σ,
     ``ω − A f(t)`` at every sample (``f`` the calibrated specific force in g,
-    ``(I + E_a)⁻¹(f_meas − b_a) / 1000``: the hand's accelerations too), the poses' means
-    again, True; else the rates and poses as they are, False."""
+    ``(I + E_a)⁻¹(f_meas − b_a) / 1000``, with K2 when fitted: the hand's accelerations
+    too), the poses' means again, True; else the rates and poses as they are, False.  An
+    ``A`` that is ``c·I`` alone (:func:`.gsens.isotropic_part`: a latitude of the wrong
+    sign) is not taken off, and ``note`` becomes why.  Returns the rates, the poses, whether
+    taken off, and ``note``."""
     if gs is None or not bool(np.any(gs.significant)):
-        return w, list(stats), False
-    e_a = model.error_matrices(acc.theta)
-    f_g = np.linalg.solve(np.eye(3) + e_a, (a - acc.theta[0:3]).T).T / units.G_TO_MG
+        return w, list(stats), False, note
+    iso = _gsens.isotropic_part(gs.matrix_deg_h_g, gs.sigma_deg_h_g)
+    if iso is not None:
+        return w, list(stats), False, _gsens.ISOTROPIC_NOTE.format(c=iso[0], s=iso[1])
+    f_g = am.force(a) / units.G_TO_MG
     w_fit = w - f_g @ (gs.matrix_deg_h_g * units.DH_TO_RS).T
-    return w_fit, pose_stats(a, w_fit, [p.section for p in stats]), True
+    return w_fit, pose_stats(a, w_fit, [p.section for p in stats]), True, note
+
+
+def _accel_model(
+    stats: Sequence[PoseStats], acc: _accel.AccelFit, idx: Sequence[int], g_mg: float,
+    accel_k2: bool, where: str,
+) -> tuple[_AccelModel, _accel_k2.AccelK2Fit | None]:  # fmt: skip
+    """The accelerometer the gyro's stage reads: the fit of :func:`_accel_fit`, or with
+    ``accel_k2`` the twelve parameters with K2 (:func:`.accel_k2.fit_k2`), and that K2 fit."""
+    if not accel_k2:
+        return _AccelModel(acc, idx, None, g_mg), None
+    try:
+        k2 = _accel_k2.fit_k2([p.f_mean_mg for p in stats], [p.mean_sigma_mg for p in stats],
+                              g_mg)  # fmt: skip
+    except DesignError as exc:
+        raise DesignError.around(exc, f"{where}: ") from None
+    return _AccelModel(k2.linear, _accel.FREE_INDEX, k2.k2_mg_per_g2, g_mg), k2
 
 
 def _gyro_fit(
     t: FloatArray, a: FloatArray, w: FloatArray, stats: Sequence[PoseStats],
-    turns: Sequence[Section], acc: _accel.AccelFit, idx: Sequence[int], g_mg: float,
+    turns: Sequence[Section], am: _AccelModel, g_mg: float,
     latitude_deg: float | None, sat: npt.NDArray[np.bool_] | None, gyro_model: str,
     where: str, sections_from: str,
 ) -> _gyro.GyroFit:  # fmt: skip
     """The gyro fit of :func:`calibrate_session`, on the accelerometer's up directions."""
     sig = np.asarray([p.mean_sigma_mg for p in stats])
     names = [p.section.name for p in stats]
-    up_of, free, free_cov = _calibrated_up(stats, acc, idx)
+    up_of, free, free_cov = _calibrated_up(stats, am)
     up = up_of(free)
     n, wm, ws = _pose_rates(stats)
     bias, bias_cov = _gyro.static_bias(wm, n, ws, up, latitude_deg)
     dt = np.diff(t)
     dt = np.concatenate([dt, dt[-1:]])
-    dir_sig = _direction_sigma(sig, names, acc.method, g_mg)
-    named = _named_turns(turns, w, dt, bias, a, acc, dict(zip(names, dir_sig, strict=True)),
+    dir_sig = _direction_sigma(sig, names, am.fit.method, g_mg)
+    named = _named_turns(turns, w, dt, bias, a, am, dict(zip(names, dir_sig, strict=True)),
                          f"{where}: section", sections_from, sat)  # fmt: skip
     gfit = _gyro.fit_rotations(
         w, dt, [p.section for p in stats], up_of, free, free_cov, bias, bias_cov,
@@ -647,6 +706,22 @@ def _gyro_fit(
     _warn_implausible(gfit, where)
     _warn_too_few_motions(gfit, where)
     return gfit
+
+
+def _gyro_stage(
+    t: FloatArray, a: FloatArray, w: FloatArray, stats: Sequence[PoseStats],
+    turns: Sequence[Section], am: _AccelModel, g_mg: float, latitude_deg: float | None,
+    saturated: npt.ArrayLike | None, gyro_model: str, where: str, sections_from: str,
+) -> tuple[_gyro.GyroFit, _gsens.GSensitivity | None, str | None, bool]:  # fmt: skip
+    """The gyro's part of :func:`calibrate_session`: its g-sensitivity, the rates with
+    ``A f`` taken off when significant (:func:`_without_g_drift`), the rotations' fit; the
+    fit, the g-sensitivity, why (not), and whether it was taken off."""
+    sat = None if saturated is None else np.asarray(saturated, dtype=bool)
+    gsens, gnote = _g_sensitivity(stats, am, g_mg, latitude_deg)
+    w_fit, stats_fit, subtracted, gnote = _without_g_drift(a, w, stats, am, gsens, gnote)
+    gfit = _gyro_fit(t, a, w_fit, stats_fit, turns, am, g_mg, latitude_deg, sat,
+                     gyro_model, where, sections_from)  # fmt: skip
+    return gfit, gsens, gnote, subtracted
 
 
 def calibrate_session(
@@ -663,6 +738,7 @@ def calibrate_session(
     sections_from: str = "the POSES file",
     saturated: npt.ArrayLike | None = None,
     gyro_model: str = "full",
+    accel_k2: bool = False,
 ) -> SessionResult:
     """Calibrate the accelerometer (and gyro) triad of one multi-position session.
 
@@ -684,6 +760,9 @@ def calibrate_session(
         The session and the source of ``sections``, as messages name them.
     gyro_model : {"full", "scale"}, optional
         The elements of the gyro's ``E`` fitted (:data:`.gyro.GYRO_MODELS`).
+    accel_k2 : bool, optional
+        Also fit each accelerometer axis's K2 (:func:`.accel_k2.fit_k2`), which the gyro's
+        stage then reads the accelerometer with (up directions, g-sensitivity, A f).
 
     Returns
     -------
@@ -737,16 +816,13 @@ def calibrate_session(
             "poses",
         )
     acc, idx = _accel_fit(stats, g_mg, where, sections_from)
+    am, k2fit = _accel_model(stats, acc, idx, g_mg, accel_k2, where)
     temp = None if temperature_c is None else _mean_over(temperature_c, statics)
-    gfit, gsens, gnote, subtracted = None, None, None, False
-    if w is not None:
-        sat = None if saturated is None else np.asarray(saturated, dtype=bool)
-        gsens, gnote = _g_sensitivity(stats, acc, idx, g_mg, latitude_deg)
-        w_fit, stats_fit, subtracted = _without_g_drift(a, w, stats, acc, gsens)
-        gfit = _gyro_fit(t, a, w_fit, stats_fit, turns, acc, idx, g_mg, latitude_deg, sat,
-                         gyro_model, where, sections_from)  # fmt: skip
+    gfit, gsens, gnote, subtracted = (None, None, None, False) if w is None else _gyro_stage(
+        t, a, w, stats, turns, am, g_mg, latitude_deg, saturated, gyro_model, where, sections_from
+    )  # fmt: skip
     return SessionResult(acc, gfit, tuple(stats), tuple(turns), g_mg, temp, not_still,
-                         gsens, gnote, subtracted)  # fmt: skip
+                         gsens, gnote, subtracted, k2fit)  # fmt: skip
 
 
 @dataclass(frozen=True)

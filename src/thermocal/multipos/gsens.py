@@ -35,6 +35,9 @@ along each turn is taken for scale factor (a simulated Ferraris session with A u
 0.1 °/s/g: scale factors 3–12σ off; imu_tk's Xsens session: the motions' reduced χ² 110,
 4.8 with it taken off).  A's own σ is not carried into the rotations' covariance (on those
 sessions the gyro's θ then stays within 3.5σ of the truth, as without a sensitivity).
+An ``A`` that is ``c I`` alone (:func:`isotropic_part`) is what a latitude of the wrong sign
+gives (a vertical earth rate off along every up direction): reported, never taken off
+(``multipos`` and ``turntable`` alike).
 """
 
 from __future__ import annotations
@@ -350,6 +353,56 @@ def _fit(y: FloatArray, var: FloatArray, f: FloatArray, cond: float) -> GSensiti
     return GSensitivity(coef[:, 1:], sd[:, 1:], coef[:, 0], chi, m - 4, m, cond)
 
 
+ISOTROPIC_NOTE = (
+    "the g-sensitivity is c·I alone (c = {c:.3g} ± {s:.2g} °/h/g): what a vertical earth "
+    "rate off by c gives (a latitude of the wrong sign), so it is not taken off the moves; "
+    "check the latitude"
+)
+"""Why an isotropic ``A`` (:func:`isotropic_part`) is reported but not subtracted, by
+``multipos`` and ``turntable`` alike."""
+
+
+def isotropic_part(matrix: npt.ArrayLike, sigma: npt.ArrayLike) -> tuple[float, float] | None:
+    r"""``(c, σ_c)`` when ``A`` is ``c I`` alone: ``c`` (the diagonal's
+    inverse-variance mean) beyond 3σ and every other part of ``A`` (the off-diagonal, the
+    diagonal less ``c``) within 3σ; else None.
+
+    ``c I f = c (g/g_0)\, u`` is a rate along the up direction ``u``: exactly what an error
+    of the vertical earth rate :math:`\Omega \sin L` gives (a latitude of the wrong sign).
+    On its own it is not taken for a sensitivity to subtract from the moves, nor stored.
+
+    Parameters
+    ----------
+    matrix, sigma : array_like, shape (3, 3)
+        The estimate ``A`` and its σ (:attr:`GSensitivity.matrix_deg_h_g`, or the sessions'
+        combined :func:`combine_g_sensitivity`) [any rate unit per g].
+
+    Returns
+    -------
+    tuple of float or None
+        ``c`` and its σ [the unit of ``matrix``], or None.
+
+    Notes
+    -----
+    .. math:: c = \frac{\sum_i A_{ii} / \sigma_{ii}^2}{\sum_i 1 / \sigma_{ii}^2}, \qquad
+              \sigma_c = \Big(\sum_i \sigma_{ii}^{-2}\Big)^{-1/2}
+
+    References
+    ----------
+    - *A method for separating the combined error coefficients of a ring-laser gyro triad
+      based on dual-axis rotation*, Chinese invention patent CN104880182, eq. (2) (the
+      earth rate in body axes).
+    """
+    a, s = np.asarray(matrix, dtype=np.float64), np.asarray(sigma, dtype=np.float64)
+    d, sd = np.diag(a), np.diag(s)
+    w = 1.0 / sd**2
+    c = float((w * d).sum() / w.sum())
+    sc = float(1.0 / np.sqrt(w.sum()))
+    off = ~np.eye(3, dtype=bool)
+    rest_seen = np.any(np.abs(a[off]) > 3.0 * s[off]) or np.any(np.abs(d - c) > 3.0 * sd)
+    return (c, sc) if abs(c) > 3.0 * sc and not rest_seen else None
+
+
 def combine_g_sensitivity(estimates: Sequence[GSensitivity]) -> tuple[FloatArray, FloatArray]:
     """One ``A`` from the estimates of several sessions (one per temperature): each element
     the inverse-variance weighted mean, its σ that of the mean, scaled by the square root of
@@ -433,6 +486,7 @@ def _solve_axis(
 
 
 __all__ = [
+    "ISOTROPIC_NOTE",
     "MAX_DESIGN_COND",
     "MIN_POSES",
     "POSES_REMEDY",
@@ -441,4 +495,5 @@ __all__ = [
     "combine_g_sensitivity",
     "fit_g_sensitivity",
     "fit_g_sensitivity_known_rate",
+    "isotropic_part",
 ]

@@ -113,6 +113,7 @@ def simulate_session(
     latitude_deg: float = 45.0,
     max_angle_deg: float = 170.0,
     g_sensitivity_deg_h_g: FloatArray | None = None,
+    accel_k2_mg_g2: FloatArray | None = None,
 ) -> dict[str, Any]:
     """One session (module docstring): ``time_s``, ``accel_mg`` (n, 3), ``gyro_deg_s``
     (n, 3), the true ``attitude`` (n, 3, 3, body → local), ``poses`` (start, end) of the
@@ -140,6 +141,9 @@ def simulate_session(
         Largest rotation between consecutive poses [°] (the smallest is 30°).
     g_sensitivity_deg_h_g : numpy.ndarray, shape (3, 3), optional
         The gyro's sensitivity to specific force [°/h per g] (:func:`simulate_attitudes`).
+    accel_k2_mg_g2 : numpy.ndarray, shape (3,), optional
+        The accelerometer's second-order coefficient per axis [mg per g²]
+        (:func:`simulate_attitudes`).
 
     Returns
     -------
@@ -169,7 +173,8 @@ def simulate_session(
                               dwell_s=dwell_s, move_s=move_s, accel_noise_mg=accel_noise_mg,
                               gyro_noise_deg_s=gyro_noise_deg_s, tremor_deg=tremor_deg,
                               latitude_deg=latitude_deg,
-                              g_sensitivity_deg_h_g=g_sensitivity_deg_h_g)  # fmt: skip
+                              g_sensitivity_deg_h_g=g_sensitivity_deg_h_g,
+                              accel_k2_mg_g2=accel_k2_mg_g2)  # fmt: skip
 
 
 def simulate_attitudes(
@@ -186,6 +191,7 @@ def simulate_attitudes(
     tremor_deg: float = 0.003,
     latitude_deg: float = 45.0,
     g_sensitivity_deg_h_g: FloatArray | None = None,
+    accel_k2_mg_g2: FloatArray | None = None,
 ) -> dict[str, Any]:
     """A session through the given still ``attitudes`` (body → local ENU rotations, each
     move shorter than a half turn), as :func:`simulate_session` (which draws them at
@@ -212,6 +218,10 @@ def simulate_attitudes(
     g_sensitivity_deg_h_g : numpy.ndarray, shape (3, 3), optional
         The gyro's sensitivity to specific force ``A`` (row: gyro axis, column: the specific
         force's axis) [°/h per g] (:mod:`thermocal.multipos.gsens`); None: none.
+    accel_k2_mg_g2 : numpy.ndarray, shape (3,), optional
+        The accelerometer's second-order coefficient per axis [mg per g², g = 1000 mg]:
+        each axis reads ``K2_i (a_i/g)²`` more under the true specific force ``a``
+        (:mod:`thermocal.multipos.accel_k2`); None: none.
 
     Returns
     -------
@@ -222,7 +232,7 @@ def simulate_attitudes(
     w_nb, poses, _turns = _body_rates(rng, attitudes, {}, spec)
     return _measure(rng, attitudes[0], w_nb, poses, accel_theta, gyro_theta,
                     accel_noise_mg, gyro_noise_deg_s, latitude_deg, rate_hz,
-                    g_sensitivity_deg_h_g)  # fmt: skip
+                    g_sensitivity_deg_h_g, accel_k2_mg_g2)  # fmt: skip
 
 
 FERRARIS_TURNS: dict[str, tuple[str, float]] = {
@@ -462,9 +472,11 @@ def _measure(
     latitude_deg: float,
     rate_hz: float,
     g_sensitivity: FloatArray | None = None,
+    accel_k2: FloatArray | None = None,
 ) -> dict[str, Any]:
     """The attitude from the body rate, and what the triads read (module docstring); the
-    gyro's bias moves by ``g_sensitivity`` [°/h per g] times the true specific force."""
+    gyro's bias moves by ``g_sensitivity`` [°/h per g] times the true specific force, each
+    accelerometer axis reads ``accel_k2`` [mg per g²] times its square [g²] more."""
     dt = 1.0 / rate_hz
     n = w_nb.shape[0]
     d = attitude_along(np.vstack([w_nb, np.zeros((1, 3))]), np.full(n + 1, dt))
@@ -487,6 +499,8 @@ def _measure(
     e_a = model.error_matrices(accel_theta)
     e_g = model.error_matrices(gyro_theta)
     accel = f_true @ (np.eye(3) + e_a).T + accel_theta[0:3]
+    if accel_k2 is not None:  # IEEE Std 1293-1998's K2 a², a in g (1000 mg)
+        accel += np.asarray(accel_k2) * (f_true / 1000.0) ** 2
     accel += rng.normal(0, accel_noise_mg, size=accel.shape)
     gyro = w_true @ (np.eye(3) + e_g).T + gyro_theta[0:3] * units.DH_TO_RS
     if g_sensitivity is not None:  # specific force in g (standard gravity: 1000 mg)

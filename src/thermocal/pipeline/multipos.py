@@ -25,9 +25,14 @@ from thermocal import units
 from thermocal.errors import DesignError, ParameterError, ThermocalInputError, ThermocalWarning
 from thermocal.inspection import saturated_mask
 from thermocal.models.calibration import Calibration, Triad
-from thermocal.multipos.accel_k2 import AccelK2Fit, fit_k2
+from thermocal.multipos.accel_k2 import AccelK2Fit
 from thermocal.multipos.calibrate import METHOD, SessionResult, calibrate_session
-from thermocal.multipos.gsens import SIGNIFICANT_SIGMA, combine_g_sensitivity
+from thermocal.multipos.gsens import (
+    ISOTROPIC_NOTE,
+    SIGNIFICANT_SIGMA,
+    combine_g_sensitivity,
+    isotropic_part,
+)
 from thermocal.multipos.poses import (
     DRIFT_DEG,
     MOTION_FRACTION,
@@ -502,12 +507,17 @@ def _with_offsets(res: SessionResult, acc_off_mg: float, gyr_off_deg_h: float) -
     th = res.accel.theta.copy()
     th[0:3] += acc_off_mg
     poses = tuple(replace(p, f_mean_mg=p.f_mean_mg + acc_off_mg) for p in res.poses)
+    k2 = res.accel_k2
+    if k2 is not None:  # the K2 fit's bias too (the model is the same about the zero)
+        tk = k2.linear.theta.copy()
+        tk[0:3] += acc_off_mg
+        k2 = replace(k2, linear=replace(k2.linear, theta=tk))
     gyro = res.gyro
     if gyro is not None:
         tg = gyro.theta.copy()
         tg[0:3] += gyr_off_deg_h
         gyro = replace(gyro, theta=tg)
-    return replace(res, accel=replace(res.accel, theta=th), gyro=gyro, poses=poses)
+    return replace(res, accel=replace(res.accel, theta=th), gyro=gyro, poses=poses, accel_k2=k2)
 
 
 def _detect(t: np.ndarray, acc: np.ndarray, w: np.ndarray | None, opts: MultiposOptions,
@@ -609,10 +619,10 @@ def _session(
             rec.time_s, acc, w, g_mg=float(grav.g_m_s2) / 9.80665e-3,
             latitude_deg=grav.latitude_deg, sections=sections, static_s=opts.static_s,
             temperature_c=temp, where=str(path), saturated=sat, sections_from=str(poses),
-            gyro_model=opts.gyro_model,
+            gyro_model=opts.gyro_model, accel_k2=opts.accel_k2,
         )  # fmt: skip
     except DesignError as exc:
-        if "distinct poses" not in str(exc):
+        if "distinct poses" not in str(exc) or "K2" in str(exc):  # K2's own: said whole
             raise
         offset = (
             "; or, if the raw counts' zero is not 0 (unsigned ADC counts sit around "
@@ -625,21 +635,7 @@ def _session(
     res = _with_offsets(res, acc_off_mg, g_off_dh)
     t_range = (float(np.min(temp)), float(np.max(temp))) if temp is not None else None
     offsets = {"accel": a_off, **({"gyro": g_off} if gyr_cols else {})}
-    k2 = _k2(res, acc_off_mg, str(path)) if opts.accel_k2 else None
-    return SessionRun(path, res, t_range, det, offsets, k2), au, gu
-
-
-def _k2(res: SessionResult, acc_off_mg: float, where: str) -> AccelK2Fit:
-    """The session's accelerometer with K2 per axis from its poses (the columns' zero put
-    back into the bias)."""
-    try:
-        k2 = fit_k2([p.f_mean_mg for p in res.poses], [p.mean_sigma_mg for p in res.poses],
-                    res.g_mg)  # fmt: skip
-    except DesignError as exc:
-        raise DesignError.around(exc, f"{where}: ") from None
-    theta = k2.linear.theta.copy()
-    theta[0:3] += acc_off_mg
-    return replace(k2, linear=replace(k2.linear, theta=theta))
+    return SessionRun(path, res, t_range, det, offsets, res.accel_k2), au, gu
 
 
 def _g_sensitivity(
@@ -661,12 +657,17 @@ def _g_sensitivity(
         return StoredGSensitivity(None, None, unit, False, f"not estimated: {note}", 0), runs
     a, sig = combine_g_sensitivity(found)
     beyond = bool(np.any(np.abs(a) > SIGNIFICANT_SIGMA * sig))
-    store = opts.g_sensitivity == "apply" or (opts.g_sensitivity == "auto" and beyond)
+    iso = isotropic_part(a, sig) if beyond else None
+    store = opts.g_sensitivity == "apply" or (
+        opts.g_sensitivity == "auto" and beyond and iso is None
+    )
     why = {
         "apply": "stored as asked (apply)",
         "off": "not stored (off)",
         "auto": f"stored: an element is beyond {SIGNIFICANT_SIGMA:g}σ"
-        if beyond
+        if store
+        else "not stored: " + ISOTROPIC_NOTE.format(c=iso[0], s=iso[1])
+        if iso is not None
         else f"not stored: no element beyond {SIGNIFICANT_SIGMA:g}σ",
     }[opts.g_sensitivity]
     to_g = float(units.convert(np.array([1.0]), "deg/h", g_unit)[0])
@@ -910,8 +911,9 @@ def _summary(
                           "g_sensitivity_subtracted": r.g_sensitivity_subtracted}  # fmt: skip
         if run.accel_k2 is not None:
             rd["accel_k2"] = run.accel_k2.to_dict(to_a, a_unit)
-        all_before.append(r.accel.residual_rms_before_mg**2 * len(r.poses))
-        all_after.append(r.accel.residual_rms_after_mg**2 * len(r.poses))
+        stored = _accel_fit(run)  # the fit the calibration holds (with K2 when fitted)
+        all_before.append(stored.residual_rms_before_mg**2 * len(r.poses))
+        all_after.append(stored.residual_rms_after_mg**2 * len(r.poses))
         run_dicts.append(rd)
     n_poses = sum(len(run.result.poses) for run in runs)
     out["n_poses"] = n_poses

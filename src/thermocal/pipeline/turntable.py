@@ -13,7 +13,7 @@ options as every other command (text logs, ULog/DataFlash topics).
 from __future__ import annotations
 
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
@@ -290,6 +290,8 @@ class ThermalRunsResult:
         The triads' temperature models (accel None without its columns).
     adequacy : dict
         The adequacy record of the soaks.
+    g_sensitivity : dict
+        What the calibration holds of the gyro's g-sensitivity (:func:`stored_g_sensitivity`).
     """
 
     output: Path
@@ -297,6 +299,9 @@ class ThermalRunsResult:
     gyro: _thermal.TriadThermal
     accel: _thermal.TriadThermal | None
     adequacy: dict[str, Any]
+    g_sensitivity: dict[str, Any] = field(default_factory=dict)
+    """``matrix``, ``matrix_sigma`` (the runs' pooled ``A`` in ``unit``, None when no run
+    estimated it), ``unit``, ``stored`` and ``why`` (:func:`stored_g_sensitivity`)."""
 
     def to_dict(self, spell: Callable[[str], str] | None = None) -> dict[str, Any]:
         """The result as JSON types (what the ``turntable`` command prints for several runs).
@@ -504,7 +509,10 @@ def thermal_runs(
         tref_c=tref_c, order=order,
     )  # fmt: skip
     triads = [Triad("gyro", opts.gyro, gyro_unit, temps, gyro_model, rig, latitude, record)]
-    triads[0] = _with_g_sensitivity(triads[0], [r for _f, r in runs], gyro_unit)
+    g_sens = stored_g_sensitivity([r for _f, r in runs], gyro_unit)
+    if g_sens["stored"]:
+        triads[0] = replace(triads[0], g_sensitivity=np.asarray(g_sens["matrix"]),
+                            g_sensitivity_sigma=np.asarray(g_sens["matrix_sigma"]))  # fmt: skip
     accel_model = None
     if opts.accel is not None:
         accel_model = _thermal.fit_triad(
@@ -521,26 +529,50 @@ def thermal_runs(
                   "the runs, or fit a lower {order}", "gyro_unit", "accel_unit",
                   "order")  # fmt: skip
     save_calibration(cal, output)
-    return ThermalRunsResult(output, tuple(runs), gyro_model, accel_model, record)
+    return ThermalRunsResult(output, tuple(runs), gyro_model, accel_model, record, g_sens)
 
 
-def _with_g_sensitivity(gyro: Any, runs: Sequence[TurntableResult], gyro_unit: str) -> Any:
-    """The gyro triad carrying the runs' pooled g-sensitivity when every run took its
-    ``A f`` off before its fit (its bias is then the bias at zero specific force, as
-    ``compensate`` expects); unchanged otherwise (``A`` reported, not stored)."""
-    from dataclasses import replace as _replace
+def stored_g_sensitivity(runs: Sequence[TurntableResult], gyro_unit: str) -> dict[str, Any]:
+    """The runs' pooled g-sensitivity and whether the calibration stores it: it does when
+    every run took its ``A f`` off before its fit (its bias is then the bias at zero
+    specific force, as ``compensate`` expects); otherwise ``A`` is reported, not stored.
 
+    Parameters
+    ----------
+    runs : sequence of TurntableResult
+        The soak runs.
+    gyro_unit : str
+        The gyro's unit (``A`` in it per g).
+
+    Returns
+    -------
+    dict
+        ``matrix``, ``matrix_sigma`` (3×3 lists, None when no run estimated ``A``),
+        ``unit`` (the gyro's unit per g), ``stored`` and ``why``.
+
+    Notes
+    -----
+    Each element is the runs' inverse-variance mean
+    (:func:`thermocal.turntable.gsens.pooled_g_sensitivity`).
+
+    References
+    ----------
+    - IEEE Std 1431-2004 (the acceleration-sensitive drift of the rate model).
+    """
     from thermocal.turntable.gsens import pooled_g_sensitivity
 
-    if not runs or not all(r.g_sensitivity_subtracted for r in runs):
-        return gyro
     pooled = pooled_g_sensitivity([r.g_sensitivity for r in runs])
+    out: dict[str, Any] = {"matrix": None, "matrix_sigma": None, "unit": f"{gyro_unit}/g"}
     if pooled is None:
-        return gyro
+        return {**out, "stored": False, "why": "not estimated: no run's dwells separate it"}
     to_unit = float(units.convert(np.array([1.0]), "deg/h", gyro_unit)[0])
-    return _replace(
-        gyro, g_sensitivity=pooled[0] * to_unit, g_sensitivity_sigma=pooled[1] * to_unit
-    )
+    out.update(matrix=(pooled[0] * to_unit).tolist(), matrix_sigma=(pooled[1] * to_unit).tolist())
+    taken = sum(bool(r.g_sensitivity_subtracted) for r in runs)
+    if runs and taken == len(runs):
+        return {**out, "stored": True, "why": "stored: every run took it off before its fit"}
+    why = (f"not stored: {len(runs) - taken} of {len(runs)} runs did not take it off (none "
+           "beyond 3σ, or c·I alone: their notes say which)")  # fmt: skip
+    return {**out, "stored": False, "why": why}
 
 
 def _soak_runs(

@@ -29,6 +29,10 @@ def _triad_table(kind: str, d: dict[str, Any]) -> TextTable:
         sig = d["misalignment_arcsec_sigma"][i]  # 0: an element the model holds at 0
         rows.append((f"misalignment {n}", fmt(d["misalignment_arcsec"][i], 5),
                      fmt(sig, 3) if sig else "held (not fitted)", "″"))  # fmt: skip
+    k2 = d.get("k2")  # stored with the parameters above (fitted with them)
+    if k2:
+        rows += [(f"K2 {ax}", fmt(v, 4), fmt(e, 2), k2["unit"].replace("^2", "²"))
+                 for ax, v, e in zip("xyz", k2["k2"], k2["k2_sigma"], strict=True)]  # fmt: skip
     columns = ("parameter", "value", "σ", "unit")
     return TextTable(f"{kind} triad ({d['method']})", columns, tuple(rows), ("left",) * 4)
 
@@ -114,6 +118,41 @@ def g_sensitivity_line(run: dict[str, Any], what: str = "poses") -> str | None:
     )
     why = f"; {g['g_sensitivity_note']}" if g.get("g_sensitivity_note") else ""
     return head + "; ".join(found) + f" (beyond 3σ{done}{why})"
+
+
+def g_sensitivity_table(gs: dict[str, Any], title: str) -> TextTable:
+    """A g-sensitivity ``A`` as a table: one row per gyro axis, one column per specific
+    force axis, each cell ``value ± σ`` in ``gs["unit"]``, ``*`` marking an element beyond
+    :data:`thermocal.multipos.gsens.SIGNIFICANT_SIGMA` σ.
+
+    Parameters
+    ----------
+    gs : dict
+        ``matrix`` and ``matrix_sigma`` (3×3) and ``unit``, as the results' JSON holds them.
+    title : str
+        The table's title.
+
+    Returns
+    -------
+    TextTable
+
+    References
+    ----------
+    IEEE Std 952-1997, annex B (acceleration-sensitive drift).
+    """
+    from thermocal.multipos.gsens import SIGNIFICANT_SIGMA
+
+    def cell(v: float, s: float) -> str:
+        star = " *" if s > 0 and abs(v) > SIGNIFICANT_SIGMA * s else ""
+        return f"{fmt(v, 3)} ± {fmt(s, 2)}{star}"
+
+    rows = tuple(
+        (f"gyro {ax}", *(cell(gs["matrix"][i][j], gs["matrix_sigma"][i][j]) for j in range(3)))
+        for i, ax in enumerate("xyz")
+    )
+    columns = (f"A [{gs['unit']}]", "force x", "force y", "force z")
+    return TextTable(f"{title} (* beyond {SIGNIFICANT_SIGMA:g}σ)", columns, rows,
+                     ("left",) * 4)  # fmt: skip
 
 
 def g_sensitivity_stored_line(out: dict[str, Any]) -> str | None:
@@ -216,6 +255,19 @@ def _k2_line(run: dict[str, Any]) -> str:
     )
 
 
+def _misfit_line(run: dict[str, Any], a_unit: str) -> str | None:
+    """The line said when a run's poses scatter beyond their noise in the accelerometer
+    fit the calibration stores (the one with K2 when fitted), else None."""
+    fit, what = (run["accel_k2"], " (the fit with K2)") if "accel_k2" in run else (run["accel"], "")
+    if not fit.get("misfit"):
+        return None
+    return (
+        f"{run['input']}: the poses scatter more than their noise{what} (reduced χ² "
+        f"{fmt(fit['reduced_chi2'], 3)}): each pose's σ inflated by a misfit of "
+        f"{fmt(fit['misfit'], 3)} {a_unit}, so that each counts as the misfit says"
+    )
+
+
 def multipos_summary_text(out: dict[str, Any], a_unit: str, output: Path | str) -> list[Block]:
     """A multi-position calibration's dictionary as text: each triad's table at TREF, the
     lean of the 360° turns, the poses and the gravity-magnitude residual before → after, the
@@ -249,25 +301,26 @@ def multipos_summary_text(out: dict[str, Any], a_unit: str, output: Path | str) 
                 "rest on the motions between poses"
             )
     blocks += [_k2_line(run) for run in out["runs"] if "accel_k2" in run]
+    with_k2 = " (the fit with K2, stored)" if out.get("accel", {}).get("k2") else ""
     blocks.append(
         f"{out['n_poses']} poses; gravity-magnitude residual rms "
         f"{fmt(out['gravity_residual_rms_before'], 3)} → "
-        f"{fmt(out['gravity_residual_rms_after'], 3)} {a_unit}; written {output}"
+        f"{fmt(out['gravity_residual_rms_after'], 3)} {a_unit}{with_k2}; written {output}"
     )
     stored = g_sensitivity_stored_line(out)
     blocks += [stored] if stored is not None else []
+    gs = out.get("gyro", {}).get("g_sensitivity")
+    if gs is not None and gs["matrix"] is not None:
+        state = "stored" if gs["stored"] else "not stored"
+        title = f"gyro g-sensitivity over {gs['n_sessions']} session(s), {state}"
+        blocks.append(g_sensitivity_table(gs, title))
     for run in out["runs"]:
         line = gyro_misfit_line(run)
         blocks += [line] if line is not None else []
         line = g_sensitivity_line(run)
         blocks += [line] if line is not None else []
-        if run["accel"].get("misfit"):
-            blocks.append(
-                f"{run['input']}: the poses scatter more than their noise (reduced χ² "
-                f"{fmt(run['accel']['reduced_chi2'], 3)}): each pose's σ inflated by a "
-                f"misfit of {fmt(run['accel']['misfit'], 3)} {a_unit}, so that each "
-                "counts as the misfit says"
-            )
+        line = _misfit_line(run, a_unit)
+        blocks += [line] if line is not None else []
     return blocks + pose_detection_lines(out)
 
 
@@ -313,7 +366,12 @@ def turntable_text(res: SingleRunResult) -> list[Block]:
         f"filter/LS agreement {fmt(out['agreement_max_sigma'], 2)} σ; written {res.output}",
     ]
     line = turntable_g_sensitivity_line(out, str(res.input))
-    return blocks + ([line] if line is not None else [])
+    blocks += [line] if line is not None else []
+    gs = out.get("g_sensitivity")
+    if gs is not None:  # this run's estimate (°/h/g, as the result's JSON holds it)
+        state = "taken off the moves" if out.get("g_sensitivity_subtracted") else "not taken off"
+        blocks.append(g_sensitivity_table(gs, f"gyro g-sensitivity from the dwells, {state}"))
+    return blocks
 
 
 def turntable_g_sensitivity_line(out: dict[str, Any], name: str) -> str | None:
@@ -378,12 +436,20 @@ def turntable_thermal_text(res: ThermalRunsResult) -> list[Block]:
     for f, r in res.runs:
         line = turntable_g_sensitivity_line(r.to_dict(), str(f))
         blocks += [line] if line is not None else []
+    gs = res.g_sensitivity
+    if gs:
+        blocks.append(f"gyro g-sensitivity over the soaks {gs['why']}"
+                      + ("" if gs["stored"] else ": compensate leaves it in"))  # fmt: skip
+        if gs["matrix"] is not None:
+            state = "stored" if gs["stored"] else "not stored"
+            blocks.append(g_sensitivity_table(gs, f"gyro g-sensitivity over the soaks, {state}"))
     blocks.append(f"calibration written: {res.output} (compensate applies it per sample)")
     return blocks
 
 
 __all__ = [
     "g_sensitivity_line",
+    "g_sensitivity_table",
     "gyro_misfit_line",
     "multipos_summary_text",
     "multipos_text",

@@ -6,6 +6,9 @@ before and after compensation: a turntable run's dwell-mean and move-angle error
 session's gravity-magnitude and rotation-angle errors
 (:func:`thermocal.multipos.validate.validate_held_out_session`), first as the absolute
 figures (rms over poses or motions, before → after, the change in %), then per axis.
+Each triad's second-order term comes with it (:func:`term_section`): a gyro's g-sensitivity
+``A`` (3×3) or an accelerometer's ``K2`` (per axis), each element with its σ and ``|v|/σ``
+(beyond 3σ marked), or why the calibration holds none.
 
 Against temperature only what was measured against it: a triad calibrated over several
 temperatures (a multi-position calibration with ``temps`` and a file per temperature, or a
@@ -146,7 +149,106 @@ def _runs(runs: Any, shown: list[tuple[float, str]]) -> list[dict[str, Any]]:
     ]
 
 
-def _triad_section(tri: Any) -> dict[str, Any]:
+def _cell(v: float, s: float | None) -> dict[str, Any]:
+    """A term's table cell: the value ± σ, ``|v|/σ`` and whether it lies beyond
+    :data:`thermocal.multipos.gsens.SIGNIFICANT_SIGMA` σ (no σ: not judged)."""
+    from thermocal.multipos.gsens import SIGNIFICANT_SIGMA
+
+    if s is None or not s > 0:
+        return {"text": f"{v:.4g}", "z": "—", "beyond": False}
+    z = abs(v) / s
+    return {"text": f"{v:.4g} ± {s:.2g}", "z": f"{z:.1f}", "beyond": z > SIGNIFICANT_SIGMA}
+
+
+def _absent_why(tri: Any, triads: Any) -> str:
+    """Why a gyro triad has no ``g_sensitivity`` or an accelerometer triad no ``k2`` in its
+    file, as far as the file tells (it records what was stored, not what was found)."""
+    if tri.model.kind == "gyro":
+        if not any(t.model.kind == "accel" for t in triads):
+            return ("not estimated: the calibration holds no accelerometer triad, whose "
+                    "specific force A multiplies")  # fmt: skip
+        when = (
+            "every soak's dwells found an element beyond 3σ and took it off"
+            if tri.model.method == "turntable"
+            else "an element of the poses' estimate lies beyond 3σ (not c·I alone), or "
+            "when asked for (g_sensitivity 'apply')"
+        )
+        return (f"not stored in this calibration: A is stored when {when}; the calibrating "
+                "command's output gives the estimate. The compensation leaves any "
+                "g-sensitivity in the gyro's output")  # fmt: skip
+    if tri.model.method == "turntable":
+        return ("not estimated: the turntable's accelerometer fit holds the bias, scale "
+                "factors and misalignments alone (the tumble test gives one axis's "
+                "K2)")  # fmt: skip
+    return ("not estimated: the calibration was fitted without K2 (multi-position poses at a "
+            "slant to every axis give it with accel_k2; the six faces cannot)")  # fmt: skip
+
+
+def term_section(tri: Any, triads: Any) -> dict[str, Any] | None:
+    """A triad's second-order term as the report shows it: a gyro's g-sensitivity ``A``
+    (3×3, row the gyro axis, column the specific force's axis) or an accelerometer's ``K2``
+    (per axis), each element with its σ and ``|value|/σ`` (beyond 3σ marked), or why the
+    calibration holds none; None for a triad of another kind.
+
+    Parameters
+    ----------
+    tri : Triad
+        The triad (:class:`thermocal.models.calibration.Triad`).
+    triads : sequence of Triad
+        Every triad of the calibration (a gyro's A needs an accelerometer triad).
+
+    Returns
+    -------
+    dict or None
+        ``what``, ``symbol``, ``unit``, ``matrix`` (A: True), ``rows`` (each a label and
+        its cells), ``absent`` (the reason, or None), ``formula``.
+
+    Notes
+    -----
+    The gyro reads :math:`b + A f` more at rest under the specific force :math:`f` [g]
+    (IEEE Std 952-1997 annex B); the accelerometer :math:`K_{2,i} (a_i/g)^2` more per axis
+    (IEEE Std 1293-1998).  An element is significant when :math:`|v| > 3\\sigma`.
+
+    References
+    ----------
+    - IEEE Std 952-1997, annex B (acceleration-sensitive drift).
+    - IEEE Std 1293-1998 (the accelerometer's second-order coefficient K2).
+    """
+    kind = tri.model.kind
+    if kind == "gyro":
+        value, sigma, unit = tri.g_sensitivity, tri.g_sensitivity_sigma, tri.g_sensitivity_unit
+        what, symbol = "g-sensitivity", "A"
+        formula = (
+            "compensate takes A f off: (I + E(T))⁻¹ (x − b(T) − A f), f the "
+            "accelerometer's compensated output [g]"
+        )
+    elif kind == "accel":
+        value, sigma, unit = tri.k2, tri.k2_sigma, tri.k2_unit
+        what, symbol = "second-order coefficient", "K2"
+        formula = "compensate inverts x = (I + E(T)) a + b(T) + K2 ⊙ (a/g)², g = 9.80665 m/s²"
+    else:
+        return None
+    out: dict[str, Any] = {"what": what, "symbol": symbol, "unit": unit.replace("^2", "²"),
+                           "matrix": kind == "gyro", "rows": [], "absent": None,
+                           "formula": formula}  # fmt: skip
+    if value is None:
+        out["absent"] = _absent_why(tri, triads)
+        return out
+    v = np.asarray(value, dtype=np.float64)
+    s = None if sigma is None else np.asarray(sigma, dtype=np.float64)
+    if kind == "gyro":
+        out["rows"] = [{"label": f"gyro {ax}",
+                        "cells": [_cell(float(v[i, j]), None if s is None else float(s[i, j]))
+                                  for j in range(3)]}
+                       for i, ax in enumerate("xyz")]  # fmt: skip
+    else:
+        out["rows"] = [{"label": f"K2 {ax}",
+                        "cells": [_cell(float(v[i]), None if s is None else float(s[i]))]}
+                       for i, ax in enumerate("xyz")]  # fmt: skip
+    return out
+
+
+def _triad_section(tri: Any, triads: Any = ()) -> dict[str, Any]:
     """One triad's part of the report (module docstring)."""
     m = tri.model
     shown = display_factors(tri)
@@ -177,6 +279,7 @@ def _triad_section(tri: Any) -> dict[str, Any]:
         "params": params,
         "runs": _runs(m.runs, shown) if over_t else [],
         "names": [f"{f.name} [{u}]" for f, (_c, u) in zip(m.fits, shown, strict=True)],
+        "term": term_section(tri, triads),
     }
 
 
@@ -289,7 +392,7 @@ def build_triad_report(
             calibration=Path(cal_path).name,
             version=__version__,
             generated_utc=_dt.datetime.now(_dt.UTC).strftime("%Y-%m-%d %H:%M UTC"),
-            triads=[_triad_section(tri) for tri in cal.triads],
+            triads=[_triad_section(tri, cal.triads) for tri in cal.triads],
             summary=summary,
             validation=per_axis,
             notes=notes,
@@ -326,6 +429,7 @@ __all__ = [
     "build_triad_report",
     "display_factors",
     "run_temperatures",
+    "term_section",
     "validation_rows",
     "write_triad_report",
 ]

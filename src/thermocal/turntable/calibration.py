@@ -634,14 +634,6 @@ def calibrate(
     )  # fmt: skip
 
 
-ISOTROPIC_NOTE = (
-    "the g-sensitivity is c·I alone (c = {c:.3g} ± {s:.2g} °/h/g): what a vertical earth "
-    "rate off by c gives (a latitude of the wrong sign), so it is not taken off the moves; "
-    "check the latitude"
-)
-"""Why an isotropic ``A`` (:func:`.gsens.isotropic_part`) is reported but not subtracted."""
-
-
 def _estimate_channels(
     channels: int,
     arw: FloatArray,
@@ -681,7 +673,9 @@ def _g_sensitivity(
         gs = fit(est)
     except DesignError as exc:
         return est, (None, str(exc), False)
-    iso = gsens_mod.isotropic_part(gs)
+    from thermocal.multipos.gsens import ISOTROPIC_NOTE, isotropic_part
+
+    iso = isotropic_part(gs.matrix_deg_h_g, gs.sigma_deg_h_g)
     if iso is not None:
         return est, (gs, ISOTROPIC_NOTE.format(c=iso[0], s=iso[1]), False)
     if not bool(np.any(gs.significant)):
@@ -1088,7 +1082,8 @@ def validate_turntable_run(
 
     A gyro triad holding a g-sensitivity :math:`A` has :math:`A f` taken off its samples
     before they are compensated (:math:`f` the specific force the encoders' gravity
-    direction gives, as ``compensate`` takes it off with the accelerometer's). The
+    direction gives, as ``compensate`` takes it off with the accelerometer's); an
+    accelerometer triad holding K2 is inverted with it, as ``compensate`` does. The
     reference of every sample comes from the encoder angles (the true body rate
     ``ω_ib^b = C_nᵇ ω_ie^n + ω_nb^b(α, β, α̇, β̇)`` over each interval,
     :func:`.kinematics.omega_ib_b`; the specific force ``C_nᵇ (0, 0, g)`` at rest); per triad
@@ -1164,9 +1159,17 @@ def validate_turntable_run(
                 figure_unit_factor=factor,
                 figure_unit=fig_unit,
                 g_term=_g_sensitivity_term(tri, f_true),
+                compensate=functools.partial(_compensate, tri, bias_to_data, unit),
             )
         )
     return out
+
+
+def _compensate(tri: Any, to_data: float, unit: str, x: Any, temp_c: Any) -> Any:
+    """The triad's own correction of ``x`` [``unit``] (:meth:`Triad.correct
+    <thermocal.models.calibration.Triad.correct>`: with an accelerometer's K2 when stored),
+    as ``compensate`` applies it."""
+    return tri.correct(x, temp_c, to_data, unit)
 
 
 def _g_sensitivity_term(tri: Any, f_true: npt.NDArray[np.float64]) -> Any:

@@ -25,7 +25,9 @@ The moves between dwells turn gravity in the body: the gyro reads :math:`A f(t)`
 the rotation, which the filter of :mod:`.calibration` would otherwise take for scale factor
 and misalignment.  When an element of ``A`` is significant, :func:`subtract_from_model`
 takes :math:`p_c \cdot A f(t)\,\tau` off every interval's channels (``f`` at the interval's
-mid angles) and the calibration is estimated again.
+mid angles) and the calibration is estimated again, unless ``A`` is ``c I`` alone
+(:func:`thermocal.multipos.gsens.isotropic_part`, shared with ``multipos``: what a latitude
+of the wrong sign gives).
 """
 
 from __future__ import annotations
@@ -199,46 +201,6 @@ def subtract_from_model(
     return replace(m, y_arcsec=y)
 
 
-def isotropic_part(gs: GSensitivity) -> tuple[float, float] | None:
-    r"""``(c, σ_c)`` [°/h per g] when ``A`` is ``c I`` alone: ``c`` (the diagonal's
-    inverse-variance mean) beyond 3σ and every other part of ``A`` (the off-diagonal, the
-    diagonal less ``c``) within 3σ; else None.
-
-    ``c I f = c (g/g_0)\, u`` is a rate along the up direction ``u``: exactly what an error
-    of the vertical earth rate :math:`\Omega \sin L` gives (a latitude of the wrong sign).
-    On its own it is not taken for a sensitivity to subtract from the moves.
-
-    Parameters
-    ----------
-    gs : GSensitivity
-        The estimate.
-
-    Returns
-    -------
-    tuple of float or None
-        ``c`` and its σ [°/h per g], or None.
-
-    Notes
-    -----
-    .. math:: c = rac{\sum_i A_{ii} / \sigma_{ii}^2}{\sum_i 1 / \sigma_{ii}^2}, \qquad
-              \sigma_c = \Big(\sum_i \sigma_{ii}^{-2}\Big)^{-1/2}
-
-    References
-    ----------
-    - *A method for separating the combined error coefficients of a ring-laser gyro triad
-      based on dual-axis rotation*, Chinese invention patent CN104880182, eq. (2) (the
-      earth rate in body axes).
-    """
-    a, s = gs.matrix_deg_h_g, gs.sigma_deg_h_g
-    d, sd = np.diag(a), np.diag(s)
-    w = 1.0 / sd**2
-    c = float((w * d).sum() / w.sum())
-    sc = float(1.0 / np.sqrt(w.sum()))
-    off = ~np.eye(3, dtype=bool)
-    rest_seen = np.any(np.abs(a[off]) > 3.0 * s[off]) or np.any(np.abs(d - c) > 3.0 * sd)
-    return (c, sc) if abs(c) > 3.0 * sc and not rest_seen else None
-
-
 def pooled_g_sensitivity(
     estimates: Sequence[GSensitivity | None],
 ) -> tuple[FloatArray, FloatArray] | None:
@@ -282,7 +244,6 @@ def pooled_g_sensitivity(
 __all__ = [
     "REMEDY",
     "dwell_g_sensitivity",
-    "isotropic_part",
     "pooled_g_sensitivity",
     "specific_force_g",
     "subtract_from_model",

@@ -22,7 +22,7 @@ from __future__ import annotations
 
 import itertools
 import math
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -973,6 +973,7 @@ def validate_triad(
     figure_unit_factor: float,
     figure_unit: str,
     g_term: FloatArray | None = None,
+    compensate: Callable[[FloatArray, FloatArray], FloatArray] | None = None,
 ) -> TriadValidation:
     """Compare raw and compensated samples ``x`` (n, 3, data unit) with ``reference`` (n, 3,
     same unit; the true body rate or specific force from the encoder angles) over the
@@ -1005,6 +1006,11 @@ def validate_triad(
     g_term : numpy.ndarray, shape (n, 3), optional
         A gyro's g-sensitivity term :math:`A f` [data unit], taken off before the
         compensation (the compensated samples :math:`C(x - A f)`; the raw ones as read).
+    compensate : callable, optional
+        ``compensate(x, temp_c)`` → the compensated samples [data unit]: the calibration's
+        own correction (an accelerometer's K2,
+        :meth:`thermocal.models.calibration.Triad.correct`); default :func:`correct` of
+        ``triad`` with ``bias_to_data``.
 
     Returns
     -------
@@ -1020,7 +1026,8 @@ def validate_triad(
     - *A method for separating the combined error coefficients of a ring-laser gyro triad
       based on dual-axis rotation*, Chinese invention patent CN104880182.
     """
-    xc = correct(triad, x if g_term is None else x - g_term, temp_c, bias_to_data)
+    xg = x if g_term is None else x - g_term
+    xc = correct(triad, xg, temp_c, bias_to_data) if compensate is None else compensate(xg, temp_c)
 
     def dwell_rms(v: FloatArray) -> tuple[float, float, float]:
         errs = np.array(
