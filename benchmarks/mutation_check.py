@@ -5290,8 +5290,8 @@ MUTANTS: tuple[Mutant, ...] = (
     Mutant(
         "avar-cov-rrw-gacv",
         P + "stability/allan.py",
-        "coef[3] / 4.0 * a**3",
-        "coef[3] / 3.0 * a**3",
+        "coef[3] * tau0_s**3 / 4.0]",
+        "coef[3] * tau0_s**3 / 3.0]",
         _t("allan_fit_coverage"),
         "random-walk FM's generalised autocovariance C₁|t|³/3 instead of /4",
     ),
@@ -5314,8 +5314,8 @@ MUTANTS: tuple[Mutant, ...] = (
     Mutant(
         "avar-cov-white-pm",
         P + "stability/allan.py",
-        "c_pm = (same * _W_AB).sum(axis=2) * c[0] / 3.0",
-        "c_pm = (same * _W_AB).sum(axis=2) * c[0] / 6.0",
+        "c_pm = geo.pm_same * c[0] / 3.0",
+        "c_pm = geo.pm_same * c[0] / 6.0",
         _t("allan_fit_coverage"),
         "white PM's phase variance C₋₂/6 instead of C₋₂/3",
     ),

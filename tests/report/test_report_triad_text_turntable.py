@@ -14,6 +14,7 @@ import re
 from pathlib import Path
 
 import numpy as np
+import pytest
 
 from thermocal.cli import main
 from thermocal.pipeline.turntable import stored_g_sensitivity
@@ -22,6 +23,13 @@ from thermocal.writers import write_recording
 
 A_TRUE = np.array([[0.30, -0.12, 0.05], [0.08, -0.25, 0.15], [-0.04, 0.10, 0.40]])  # °/h/g
 CELL = re.compile(r"│ ([-+0-9.e]+) ± ([0-9.e+-]+)( \*)? +")
+
+
+@pytest.fixture(autouse=True)
+def _wide_output(monkeypatch: pytest.MonkeyPatch) -> None:
+    """The tables are read cell by cell: printed whole, as to a file (a test run's
+    ``COLUMNS=80`` would wrap the 85-column table and split a cell from its star)."""
+    monkeypatch.delenv("COLUMNS", raising=False)
 
 
 def _soaks(d: Path, a_true: np.ndarray | None) -> tuple[str, Path]:

@@ -1390,14 +1390,23 @@ _COV_REACH: Final = 6
 times the longer τ beyond the windows' overlap."""
 
 
-def _phase_gacv(t_s: FloatArray, coef: FloatArray) -> FloatArray:
-    """The generalised autocovariance of the phase at lags ``t_s`` [s] for ``σ² = Σ C_p τ^p``
-    (white PM C₋₂ left out: :func:`avar_covariance` adds its δ exactly)."""
-    a = np.abs(t_s)
-    flicker = a * a * np.log(a, out=np.zeros_like(a), where=a > 0)
-    return np.asarray(
-        -0.5 * coef[1] * a + coef[2] / (4.0 * math.log(2.0)) * flicker + coef[3] / 4.0 * a**3,
-        dtype=np.float64,
+def _gacv_basis(k: FloatArray) -> FloatArray:
+    """The three power-law parts of the phase's generalised autocovariance at integer lags
+    ``k`` [samples], stacked on a new last axis: ``−|k|/2`` (white FM), ``k² ln|k|``
+    (flicker FM), ``|k|³`` (random-walk FM); :func:`_gacv_scale` turns them into
+    ``s(t)`` for a record's τ0 and coefficients (white PM C₋₂ left out:
+    :func:`avar_covariance` adds its δ exactly).  Second differences cancel the
+    ``k² ln τ0`` that a change of unit adds to flicker's part, so lags in samples do."""
+    a = np.abs(k)
+    flicker = a * a * np.log(np.where(a > 0, a, 1.0))
+    return np.stack([-0.5 * a, flicker, a * a * a], axis=-1)
+
+
+def _gacv_scale(tau0_s: float, coef: FloatArray) -> FloatArray:
+    """Weights of :func:`_gacv_basis`'s three parts in ``s(t)`` [unit²·s²]:
+    ``C₋₁ τ0``, ``C₀ τ0² / (4 ln 2)``, ``C₁ τ0³ / 4``."""
+    return np.array(
+        [coef[1] * tau0_s, coef[2] * tau0_s**2 / (4.0 * math.log(2.0)), coef[3] * tau0_s**3 / 4.0]
     )
 
 
@@ -1524,33 +1533,87 @@ def avar_covariance(
       frequency distribution in any number of variables", *Biometrika* 12 (1918) 134–139.
     """
     mm = np.asarray(m, dtype=np.int64)
-    nt = np.asarray(n_terms, dtype=np.float64)
     c = np.maximum(np.asarray(coef, dtype=np.float64), 0.0)
-    pair_ij, pid, lag, wt = _lag_points(mm, nt, bool(c[2] > 0))
+    geometry = _cov_geometry(mm, np.asarray(n_terms, dtype=np.float64), bool(c[2] > 0))
+    return _cov_combine(geometry, tau0_s, c)
+
+
+_COV_BLOCK: Final = 1 << 15
+"""Quadrature points per block of :func:`_cov_geometry` (bounds its temporaries)."""
+
+
+@dataclass(frozen=True, eq=False)
+class _CovGeometry:
+    """What :func:`avar_covariance` needs of the points alone (not of the coefficients):
+    the pairs (i ≤ j) and their shorter and longer τ's m and n, the sums over lags of the
+    products of :func:`_gacv_basis`'s parts (``quad``, (P, 3, 3)) and of the parts
+    (``lin``, (P, 3)), each weighted by the quadrature and the pairs counted; and white
+    PM's per-offset terms (``pm_same``, ``pm_cross``, ``pm_count``).  One fit computes it
+    once and combines it with each model's coefficients (:func:`_cov_combine`)."""
+
+    m: IntArray
+    n: FloatArray
+    pair_ij: IntArray
+    m1: FloatArray
+    m2: FloatArray
+    quad: FloatArray
+    lin: FloatArray
+    pm_same: FloatArray
+    pm_cross: FloatArray
+    pm_count: FloatArray
+
+
+def _count(lg: FloatArray, a: FloatArray, b: FloatArray) -> FloatArray:
+    """Pairs (k, k + lg) of a stretch of ``a`` and one of ``b`` differences."""
+    return np.asarray(np.clip(np.minimum(a, b - lg) - np.maximum(0.0, -lg), 0.0, None))
+
+
+def _cov_geometry(mm: IntArray, nt: FloatArray, flicker: bool) -> _CovGeometry:
+    """The coefficient-free part of :func:`avar_covariance` for averaging factors ``mm``,
+    difference counts ``nt``, with flicker FM's reach when ``flicker``."""
+    pair_ij, pid, lag, wt = _lag_points(mm, nt, flicker)
     i, j = pair_ij[:, 0], pair_ij[:, 1]
     swap = mm[i] > mm[j]
     first, second = np.where(swap, j, i), np.where(swap, i, j)  # m1 ≤ m2
     m1, m2 = mm[first].astype(np.float64), mm[second].astype(np.float64)
     n1, n2 = nt[first], nt[second]
-    ramp = 8.0 * c[4] * (m1 * tau0_s) ** 2 * (m2 * tau0_s) ** 2  # 4μ₁μ₂, μ = Rτ²
+    n_pairs = i.size
+    quad = np.zeros((n_pairs, 3, 3))
+    lin = np.zeros((n_pairs, 3))
+    for lo in range(0, lag.size, _COV_BLOCK):
+        blk = slice(lo, lo + _COV_BLOCK)
+        p, lg = pid[blk], lag[blk]
+        d = _OFF_A[None, :] * m1[p, None] - _OFF_B[None, :] * m2[p, None]
+        g = np.einsum("nkp,k->np", _gacv_basis(d - lg[:, None]), _W_AB)
+        w = wt[blk] * _count(lg, n1[p], n2[p])
+        for u in range(3):
+            lin[:, u] += np.bincount(p, weights=w * g[:, u], minlength=n_pairs)
+            for v in range(u, 3):
+                quad[:, u, v] += np.bincount(p, weights=w * g[:, u] * g[:, v], minlength=n_pairs)
+    quad += np.triu(quad, 1).transpose(0, 2, 1)
+    dp = _OFF_A[None, :] * m1[:, None] - _OFF_B[None, :] * m2[:, None]
+    same = dp[:, :, None] == dp[:, None, :]
+    pm_same = (same * _W_AB).sum(axis=2)  # white PM's δ, times C₋₂/3
+    pm_cross = np.einsum("nkjp,j->nkp", _gacv_basis(dp[:, None, :] - dp[:, :, None]), _W_AB)
+    pm_count = _count(dp, n1[:, None], n2[:, None]) / same.sum(axis=2)  # each lag once
+    return _CovGeometry(mm, nt, pair_ij, m1, m2, quad, lin, pm_same, pm_cross, pm_count)
 
-    def count(lg: FloatArray, a: FloatArray, b: FloatArray) -> FloatArray:
-        return np.asarray(np.clip(np.minimum(a, b - lg) - np.maximum(0.0, -lg), 0.0, None))
 
-    d = _OFF_A[None, :] * m1[pid, None] - _OFF_B[None, :] * m2[pid, None]
-    cc = _phase_gacv((d - lag[:, None]) * tau0_s, c) @ _W_AB
-    f = wt * count(lag, n1[pid], n2[pid]) * (2.0 * cc * cc + ramp[pid] * cc)
-    total = np.bincount(pid, weights=f, minlength=i.size)
+def _cov_combine(geo: _CovGeometry, tau0_s: float, c: FloatArray) -> FloatArray:
+    """:func:`avar_covariance` from its geometry and the (non-negative) coefficients ``c``:
+    per pair ``Σ_l n(l)(2c(l)² + 4μμ′c(l))`` with ``c(l)`` linear in the parts."""
+    scale = _gacv_scale(tau0_s, c)
+    ramp = 8.0 * c[4] * (geo.m1 * tau0_s) ** 2 * (geo.m2 * tau0_s) ** 2  # 4μ₁μ₂, μ = Rτ²
+    total = 2.0 * np.einsum("u,nuv,v->n", scale, geo.quad, scale) + ramp * (geo.lin @ scale)
     if c[0] > 0:  # white PM: a δ at the lags where two phase points coincide
-        dp = _OFF_A[None, :] * m1[:, None] - _OFF_B[None, :] * m2[:, None]
-        same = dp[:, :, None] == dp[:, None, :]
-        c_pm = (same * _W_AB).sum(axis=2) * c[0] / 3.0
-        c_o = _phase_gacv((dp[:, None, :] - dp[:, :, None]) * tau0_s, c) @ _W_AB
-        g = count(dp, n1[:, None], n2[:, None]) / same.sum(axis=2)  # each lag once
-        total += np.sum(g * (2.0 * (2.0 * c_o * c_pm + c_pm**2) + ramp[:, None] * c_pm), axis=1)
-    tau = mm.astype(np.float64) * tau0_s
-    out = np.zeros((mm.size, mm.size))
-    out[i, j] = total / (4.0 * tau[i] ** 2 * tau[j] ** 2 * nt[i] * nt[j])
+        c_pm = geo.pm_same * c[0] / 3.0
+        c_o = geo.pm_cross @ scale
+        pm = 2.0 * (2.0 * c_o * c_pm + c_pm**2) + ramp[:, None] * c_pm
+        total += np.sum(geo.pm_count * pm, axis=1)
+    i, j = geo.pair_ij[:, 0], geo.pair_ij[:, 1]
+    tau = geo.m.astype(np.float64) * tau0_s
+    out = np.zeros((geo.m.size, geo.m.size))
+    out[i, j] = total / (4.0 * tau[i] ** 2 * tau[j] ** 2 * geo.n[i] * geo.n[j])
     out[j, i] = out[i, j]
     return out
 
@@ -1636,13 +1699,16 @@ def _fit(
     cols = np.ones(5, dtype=bool)
     dropped: dict[int, tuple[float, float]] = {}
     cov_s2: FloatArray | None = None  # of the full model while choosing, the final one after
+    geometry: _CovGeometry | None = None  # the points' part of it, computed once
     while True:
         coef, aw, w = _irls(design, s2, edf, cols)
         resid = aw @ coef - s2 * w
         active = coef > 0
         red_chi2 = float(resid @ resid / max(tau.size - int(active.sum()), 1))
         if cov_s2 is None:
-            cov_s2 = avar_covariance(result.m[ok], result.n_terms[ok], result.tau0_s, coef)
+            m_ok, n_ok = result.m[ok].astype(np.int64), result.n_terms[ok].astype(np.float64)
+            geometry = _cov_geometry(m_ok, n_ok, bool(coef[2] > 0))
+            cov_s2 = _cov_combine(geometry, result.tau0_s, np.maximum(coef, 0.0))
         sigma = _fit_sigma(aw, w, active, cov_s2, red_chi2)
         with np.errstate(invalid="ignore", divide="ignore"):
             ratio = np.where(active & (coef < significance * sigma), coef / sigma, np.inf)
@@ -1651,8 +1717,8 @@ def _fit(
         j = int(np.argmin(ratio))  # the least significant term leaves the model
         dropped[j] = (float(coef[j]), float(sigma[j]))
         cols[j] = False
-    if dropped:  # the standard errors of the model kept
-        cov_s2 = avar_covariance(result.m[ok], result.n_terms[ok], result.tau0_s, coef)
+    if dropped and geometry is not None:  # the standard errors of the model kept
+        cov_s2 = _cov_combine(geometry, result.tau0_s, np.maximum(coef, 0.0))
         sigma = _fit_sigma(aw, w, active, cov_s2, red_chi2)
     reasons: list[str | None] = []
     for j in range(5):
