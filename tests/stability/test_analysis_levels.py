@@ -51,12 +51,17 @@ def test_a_fourth_level_passes_silently(where: int) -> None:
 
 def test_noise_passes_without_numpy_ma() -> None:
     """The check on a noise record imports no masked-array module (np.unique would: 6 to
-    13 ms of a command's start), in a fresh interpreter."""
+    13 ms of a command's start), in a fresh interpreter.  numpy < 2 imports ``numpy.ma``
+    with itself (the floor check's 1.26): there the check can add nothing, and is skipped."""
     code = (
         "import sys, numpy as np\n"
+        "print('numpy.ma' in sys.modules)\n"
         "from thermocal.stability.analysis import check_not_stuck\n"
         "check_not_stuck(np.random.default_rng(2).normal(size=200_000), 'gx', 'f.csv')\n"
         "print('numpy.ma' in sys.modules)\n"
     )
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
-    assert out.stdout.strip() == "False"
+    with_numpy, after = out.stdout.split()
+    if with_numpy == "True":
+        pytest.skip("this numpy imports numpy.ma with itself")
+    assert after == "False"

@@ -222,7 +222,10 @@ def welch(
         k = min(rows, n_seg - a)
         block, sp = buf[:k], spec[:k]
         np.multiply(view[a : a + k], w, out=block)
-        np.fft.rfft(block, axis=1, out=sp)
+        if _RFFT_OUT:
+            np.fft.rfft(block, axis=1, out=sp)
+        else:  # numpy < 2 has no ``out``: the same transform, its result copied
+            sp[...] = np.fft.rfft(block, axis=1)
         for r in range(k):
             np.multiply(slope_spectrum, moments[a + r], out=line)
             np.subtract(sp[r], line, out=sp[r])
@@ -238,6 +241,9 @@ def welch(
         psd[-1] /= 2.0
     return np.asarray(np.fft.rfftfreq(seg, 1.0 / fs), dtype=np.float64), psd, n_seg
 
+
+_RFFT_OUT: Final = np.lib.NumpyVersion(np.__version__) >= "2.0.0"
+"""``numpy.fft.rfft`` takes ``out`` from numpy 2.0 (the floor, 1.26, does not)."""
 
 _WELCH_ROWS: Final = 8
 """Segments :func:`welch` transforms at a time (8 of 65 536 samples: 4 MB, in the cache)."""
