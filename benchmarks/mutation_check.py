@@ -5415,6 +5415,14 @@ MUTANTS: tuple[Mutant, ...] = (
         _t("turntable_validate_k2"),
         "a turntable validation judging an accelerometer without the K2 its calibration stores",
     ),
+    Mutant(
+        "chamber-column-without-log-hint",
+        P + "readers/dispatch.py",
+        "if c == CHAMBER_COLUMN and c in tmp_names and not hint:",
+        "if False:",
+        _t("chamber_log_attacks", "tumble_cli"),
+        "--temps chamber without a chamber log told only that the file has no such column",
+    ),
 )
 
 

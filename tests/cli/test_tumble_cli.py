@@ -210,6 +210,10 @@ def test_the_chamber_log_gives_the_test_temperature(
     assert res["temperature"] is None and res["stations"][0]["temp_c"] is None
     assert main(["tumble", str(p), "--angle-column", "angle", "--chamber-offset", "2000"]) == 2
     _one_line_error(capsys, "--chamber-offset applies with --chamber-log")
+    # --temps chamber without a log: told where that temperature comes from
+    assert main(["tumble", str(p), "--angle-column", "angle", "--temps", "chamber"]) == 2
+    _one_line_error(capsys, "no column 'chamber'", "chamber log's temperature",
+                    "--chamber-log FILE:CHANNEL")  # fmt: skip
 
 
 def test_a_continuous_tumble_from_a_bag_topic_and_its_stamps(

@@ -72,7 +72,20 @@ def test_chamber_options_without_a_log_and_a_missing_log(
             "--chamber-drift applies with --chamber-offset",
         ),
         (["--chamber-log", str(rec), "--chamber-date-order", "ymd"], "must be dmy or mdy"),
+        (["--temps", "T,chamber"], "is the chamber log's temperature: give the log, --chamber-log"),
     ):
         code = main([*base, *extra])
         err = capsys.readouterr().err.splitlines()
         assert code == 2 and len(err) == 1 and said in err[0], err
+
+
+def test_chamber_without_a_log_names_the_parameter_in_the_library(tmp_path: Path) -> None:
+    """The library's message names its parameter ``chamber_log``, not the command line's."""
+    from thermocal.errors import MissingColumnError
+    from thermocal.readers import read_recording
+    from thermocal.readers.options import ReadOptions
+
+    rec, _ = write_recording(tmp_path / "rec.csv", offset_s=20.0, span_s=600.0)
+    with pytest.raises(MissingColumnError, match="give the log, chamber_log FILE:CHANNEL"):
+        read_recording(rec, ReadOptions(temperatures=("T", "chamber"), time_unit="s",
+                                        signal_unit="deg/h", temp_unit="degC"))  # fmt: skip

@@ -409,9 +409,15 @@ def column_roles(
             same = [n for n in names if units.strip_unit_from_name(n) == c.strip()]
             if len(same) == 1 and not hint:  # 'acc_x' for the file's 'acc_x [counts]'
                 hint = f" (did you mean {same[0]!r}? give the name as the file writes it)"
+            if c == CHAMBER_COLUMN and c in tmp_names and not hint:  # no log was joined
+                hint = (
+                    f" ({CHAMBER_COLUMN!r} is the chamber log's temperature: give the log, "
+                    "{chamber_log} FILE:CHANNEL)"
+                )
             raise MissingColumnError.naming(
                 f"{p}: no column {short_name(c)}; available: {names_list(names)}{hint}",
                 *TIME_HINT_PARAMETERS,
+                *(("chamber_log",) if "{chamber_log}" in hint else ()),
             )
     return time_col, sig_names, tmp_names
 
