@@ -5423,6 +5423,14 @@ MUTANTS: tuple[Mutant, ...] = (
         _t("chamber_log_attacks", "tumble_cli"),
         "--temps chamber without a chamber log told only that the file has no such column",
     ),
+    Mutant(
+        "multipos-read-ignores-topic",
+        P + "cli/multipos_cmd.py",
+        "        read=read,\n",
+        '        read=read.replace(topic=None, stamp="header"),\n',
+        _t("multipos_bag"),
+        "multipos reading a bag's first IMU topic and its header stamps whatever was asked",
+    ),
 )
 
 

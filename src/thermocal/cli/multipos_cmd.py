@@ -15,20 +15,15 @@ from thermocal import defaults as _poses
 from thermocal._lazy import LazyModule
 from thermocal.cli.application import app
 from thermocal.cli.common import (
-    DecimalOpt,
-    DelimiterOpt,
     JsonOpt,
-    NamesOpt,
-    OnBadLinesOpt,
     OutOpt,
-    RateOpt,
     TimeOpt,
     TimeUnitOpt,
     TriadAccelUnitOpt,
     chamber_log_options,
     emit,
+    file_read_options,
     handle_errors,
-    read_options,
     show,
     split_names,
 )
@@ -39,6 +34,7 @@ from thermocal.report import triad_text as _triad_text
 if TYPE_CHECKING:
     import thermocal.pipeline.multipos as _mpf
     import thermocal.units as units
+    from thermocal.readers.options import ReadOptions
 else:
     _mpf = LazyModule("thermocal.pipeline.multipos")
     units = LazyModule("thermocal.units")
@@ -195,6 +191,7 @@ AccelK2Opt = Annotated[
 @app.command("multipos")
 @handle_errors
 @chamber_log_options
+@file_read_options
 def multipos_cmd(
     files: MultiposFilesArg,
     output: OutOpt,
@@ -222,12 +219,9 @@ def multipos_cmd(
     time_unit: TimeUnitOpt = None,
     accel_scale: AccelScaleOpt = None,
     gyro_scale: GyroScaleOpt = None,
-    t_names: NamesOpt = None,
-    t_rate: RateOpt = None,
-    t_bad: OnBadLinesOpt = "error",
-    t_delim: DelimiterOpt = None,
-    t_dec: DecimalOpt = None,
     as_json: JsonOpt = False,
+    *,
+    read: "ReadOptions",
 ) -> None:
     """Accelerometer (and gyro) triad bias, scale factors and misalignments from hand-placed
     poses, without a turntable (Tedaldi et al. 2014; Ferraris et al. 1995)."""
@@ -241,9 +235,7 @@ def multipos_cmd(
         window_s, still_threshold, motion_fraction, drift_deg, accel_offset, gyro_offset,
         gyro_model,
         g_sensitivity=g_sensitivity,
-        read=read_options(
-            names=t_names, rate=t_rate, on_bad_lines=t_bad, delimiter=t_delim, decimal=t_dec
-        ),
+        read=read,
         accel_k2=accel_k2,
     )  # fmt: skip
     res = _mpf.calibrate_files(files, output, opts, poses)
