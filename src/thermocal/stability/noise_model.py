@@ -36,6 +36,7 @@ import json
 import math
 import re
 import warnings
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 from typing import Any, Final, Literal
 
@@ -420,13 +421,17 @@ def axis_noise(
             f"the noise model needs one of {', '.join(kind_units)} "
             f"(--{'gyro' if sensor == 'gyro' else 'accel'}-unit)"
         )
-    lattice = lattice_step(values)
     v = np.asarray(values, dtype=np.float64).ravel()
     longest = max(segments, key=lambda sl: sl.stop - sl.start) if segments else slice(None)
-    found = periodic_terms(v[longest], tau0_s, u)
-    res = overlapping_adev(
-        values, tau0_s, taus, time_s=time_s, segments=segments, unit=u, confidence=confidence
-    )
+    # the periodogram in a thread beside the lattice and the ADEV, as allan's channels do
+    # (numpy's FFT and loops release the GIL; the ADEV does not overwrite ``values`` here)
+    with ThreadPoolExecutor(max_workers=1) as pool:
+        periodic = pool.submit(periodic_terms, v[longest], tau0_s, u)
+        lattice = lattice_step(values)
+        res = overlapping_adev(
+            values, tau0_s, taus, time_s=time_s, segments=segments, unit=u, confidence=confidence
+        )
+        found = periodic.result()
     terms = noise_terms(res, periodic=found)
     quant = quantization_from_lattice(lattice, tau0_s, u, terms)
     terms = annotate_quantization(terms, quant)
