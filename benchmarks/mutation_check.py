@@ -5431,6 +5431,14 @@ MUTANTS: tuple[Mutant, ...] = (
         _t("multipos_bag"),
         "multipos reading a bag's first IMU topic and its header stamps whatever was asked",
     ),
+    Mutant(
+        "fleet-validation-names-scratch",
+        P + "fleet/batch.py",
+        "    return name if value == scratch else value\n",
+        "    return value\n",
+        _t("fleet"),
+        "a fleet unit's validation.json naming the worker's deleted scratch calibration",
+    ),
 )
 
 

@@ -100,6 +100,12 @@ def test_a_batch_in_this_process(
     assert "bad_mod.parquet" in html and "yield" in html
     assert "u06" in html.split('id="outliers"')[1].split("</section>")[0]  # the outlier named
     assert not list((out / "units").glob(".*"))  # no temporary directory left
+    # a unit's validation names the calibration beside it, not the worker's scratch copy
+    for uid in SLOPES:
+        folder = out / "units" / uid
+        val = json.loads((folder / "validation.json").read_text())
+        assert val["model"] == "calibration.json", val["model"]
+        assert (folder / val["model"]).is_file()
 
 
 def test_the_slope_recovered_against_the_truth(batch: Path, tmp_path: Path) -> None:

@@ -233,8 +233,8 @@ def run_unit(task: UnitTask) -> UnitOutcome:
             opts = dataclasses.replace(task.validate, modeling=Path(u.modeling[0]))
             val = Path(u.validation)
             report = _step(outcome, lambda: validate_files(cal, val, opts))
-            if report is not None:
-                text = json_text(report.to_dict())
+            if report is not None:  # naming the calibration beside it, not the scratch copy
+                text = json_text(_beside(report.to_dict(), str(cal), CALIBRATION_FILE))
                 outcome.validation = json.loads(text)
                 outcome.files[VALIDATION_FILE] = text.encode("utf-8")
         if outcome.error is None:
@@ -245,6 +245,17 @@ def run_unit(task: UnitTask) -> UnitOutcome:
                 outcome.error = one_line_error(exc)
     outcome.seconds = time.perf_counter() - t0
     return outcome
+
+
+def _beside(value: Any, scratch: str, name: str) -> Any:
+    """``value`` (a validation's JSON object) with every string equal to ``scratch`` (the
+    worker's temporary calibration file, deleted with its folder) replaced by ``name``: the
+    calibration's file name in the unit's folder, where ``validation.json`` sits beside it."""
+    if isinstance(value, dict):
+        return {k: _beside(v, scratch, name) for k, v in value.items()}
+    if isinstance(value, list | tuple):
+        return [_beside(v, scratch, name) for v in value]
+    return name if value == scratch else value
 
 
 _THREADPOOLS: list[tuple[int, Any]] = []
