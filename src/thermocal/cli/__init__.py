@@ -15,8 +15,9 @@ option's annotation string when it builds the help, a third of ``--help``'s time
 from __future__ import annotations
 
 import importlib
+import os
 import sys
-from typing import Any
+from typing import Any, Final
 
 import typer
 
@@ -157,10 +158,29 @@ def main(argv: list[str] | None = None) -> int:
     int
         The exit status.
     """
+    if argv is None:  # the process's own command line
+        _quiet_idle_blas_threads()
     status = _run(list(sys.argv[1:] if argv is None else argv))
     if argv is None:  # the process's own command line: it ends next
         _leave_to_exit()
     return status
+
+
+BLAS_THREAD_TIMEOUT: Final = "4"
+"""``OPENBLAS_THREAD_TIMEOUT`` of a command's process: an idle OpenBLAS thread spins 2⁴ cycles
+before it sleeps, where the default 2²⁸ (≈ 0.1 s) spins after numpy's import and after every
+threaded call, on a core the command's own threads (pyarrow's reader, the kernels') need."""
+
+
+def _quiet_idle_blas_threads() -> None:
+    """Before numpy is imported by the process's own command: OpenBLAS's idle threads told to
+    sleep at once (:data:`BLAS_THREAD_TIMEOUT`; a value the user set is kept).  The threads
+    still share a large product's work; what goes is their spinning between calls, measured
+    at 0.1 s of CPU and up to 0.06 s of wall time on a 2-core machine for ``thermocal allan``
+    on 10⁷ rows (``benchmarks/RESULTS.md``).  Nothing changes once numpy is loaded (a
+    notebook, the tests), where OpenBLAS has read its environment already."""
+    if "numpy" not in sys.modules:
+        os.environ.setdefault("OPENBLAS_THREAD_TIMEOUT", BLAS_THREAD_TIMEOUT)
 
 
 def _leave_to_exit() -> None:
