@@ -5439,6 +5439,15 @@ MUTANTS: tuple[Mutant, ...] = (
         _t("fleet"),
         "a fleet unit's validation.json naming the worker's deleted scratch calibration",
     ),
+    Mutant(
+        "checks-hold-last-column",
+        P + "recording.py",
+        "        del arr  # a lazy file's mapping releases a column before it reads the next",
+        "        pass  # a lazy file's mapping releases a column before it reads the next",
+        _t("checks_hold_one_column"),
+        "the recording's checks holding each column while the next is read (one more column "
+        "at peak)",
+    ),
 )
 
 

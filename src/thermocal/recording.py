@@ -1247,6 +1247,7 @@ def _column_problems(rec: Recording) -> tuple[list[Problem], dict[str, list[Prob
         arr = rec.columns[name]
         span = _finite_range(arr)  # one pass: finite, and the signal's plausible range
         nan[name] = [] if span is not None else _nan_problems(rec, name, arr)
+        del arr  # a lazy file's mapping releases a column before it reads the next: no hold
         if name in rec.temperatures:
             plausible["T:" + name] = _temperature_problems(rec, name)
         if name in rec.signals:
