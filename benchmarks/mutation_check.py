@@ -5448,6 +5448,14 @@ MUTANTS: tuple[Mutant, ...] = (
         "the recording's checks holding each column while the next is read (one more column "
         "at peak)",
     ),
+    Mutant(
+        "unit-problem-names-signal-unit",
+        P + "recording.py",
+        '    if not own or "signal_unit" not in p.parameters:',
+        "    if True:",
+        _t("count_warning_names_own_unit"),
+        "multipos' raw-count warning naming --signal-unit, an option it does not have",
+    ),
 )
 
 

@@ -17,9 +17,9 @@ import dataclasses
 import itertools
 import math
 import warnings
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Iterator, Mapping
 from dataclasses import dataclass, field
-from typing import Any, Literal
+from typing import Any, Final, Literal
 
 import numpy as np
 import numpy.typing as npt
@@ -668,7 +668,9 @@ class Recording:
         u.update(new_units)
         return dataclasses.replace(self, columns=cols, units=u)
 
-    def validate(self, required: list[str] | None = None) -> None:
+    def validate(
+        self, required: list[str] | None = None, unit_parameters: Mapping[str, str] | None = None
+    ) -> None:
         """Raise the first error of :func:`find_problems`, warn for the doubtful.
 
         Implausible values that are only doubtful are emitted as
@@ -679,6 +681,9 @@ class Recording:
         ----------
         required : list of str, optional
             Columns that must be present.
+        unit_parameters : mapping of str to str, optional
+            Signal column → the parameter its unit was given by, where not ``signal_unit``
+            (``{"ax": "accel_unit"}``): a problem of that column names it instead.
 
         Raises
         ------
@@ -691,7 +696,7 @@ class Recording:
         ThermocalInputError
             Any other error of :func:`find_problems`.
         """
-        problems = find_problems(self, required=required)
+        problems = [_unit_named(p, unit_parameters) for p in find_problems(self, required)]
         for p in problems:
             text = f"{self.name}: {p.message}"
             if p.severity == "warning" and p.kind.startswith("implausible"):
@@ -708,6 +713,30 @@ class Recording:
                     "nonfinite_time": TimestampError,
                 }.get(p.kind, ThermocalInputError)
                 raise cls.naming(f"{self.name}: {p.message}", *p.parameters)
+
+
+def _unit_named(p: Problem, unit_parameters: Mapping[str, str] | None) -> Problem:
+    """``p`` naming its column's own unit parameter (``unit_parameters``) where it names
+    ``signal_unit``: a command whose accelerometer unit is ``accel_unit`` says so."""
+    own = (unit_parameters or {}).get(p.column or "")
+    if not own or "signal_unit" not in p.parameters:
+        return p
+    message = p.message.replace(COUNT_UNIT_EXAMPLES, _OWN_EXAMPLES.get(own, COUNT_UNIT_EXAMPLES))
+    return dataclasses.replace(
+        p,
+        message=message.replace("{signal_unit}", "{" + own + "}"),
+        parameters=tuple(own if q == "signal_unit" else q for q in p.parameters),
+    )
+
+
+COUNT_UNIT_EXAMPLES: Final = "{signal_unit} deg/s, mg, …"
+"""The units the raw-count warning offers (:func:`_count_problems`) for any signal."""
+
+_OWN_EXAMPLES: Final = {
+    "accel_unit": "{accel_unit} mg, g, m/s^2, …",
+    "gyro_unit": "{gyro_unit} deg/s, deg/h, rad/s, …",
+}
+"""The same offer where the column's unit has its own parameter (:func:`_unit_named`)."""
 
 
 # --- pure helpers --------------------------------------------------------------------
@@ -1827,8 +1856,8 @@ def _count_problems(rec: Recording, name: str) -> list[Problem]:
             "implausible_counts",
             f"signal column {name!r} is declared in counts, but {fractional:,} of its "
             f"{finite:,} values are not integers (row {first}: {float(arr[first]):.6g}): a "
-            "count is an integer; physical values need their unit ({signal_unit} deg/s, mg, "
-            "…), averaged counts one count's size (scale_factor and scale_factor_unit in the "
+            f"count is an integer; physical values need their unit ({COUNT_UNIT_EXAMPLES}), "
+            "averaged counts one count's size (scale_factor and scale_factor_unit in the "
             "file's metadata, FILE.meta.json)",
             severity="warning",
             column=name,

@@ -599,7 +599,11 @@ def _session(
         implied_units={**dict.fromkeys(acc_cols if opts.accel_scale else [], "counts"),
                        **dict.fromkeys((gyr_cols or []) if opts.gyro_scale else [], "counts")},
     )  # fmt: skip
-    rec.validate(required=[*acc_cols, *(gyr_cols or []), *([temps] if temps else [])])
+    rec.validate(
+        required=[*acc_cols, *(gyr_cols or []), *([temps] if temps else [])],
+        unit_parameters={**dict.fromkeys(acc_cols, "accel_unit"),
+                         **dict.fromkeys(gyr_cols or [], "gyro_unit")},
+    )  # fmt: skip
     acc, au, a_off = _triad(rec, acc_cols, opts, "accel", path)
     grav.update(rec, path)
     w, gu, g_off = None, None, 0.0

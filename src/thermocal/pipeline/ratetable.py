@@ -287,7 +287,8 @@ def _read(path: Path, opts: RateTableOptions) -> tuple[Any, np.ndarray, str, np.
         temperatures=(opts.temps,) if opts.temps else None,
     )
     rec = read_recording(path, read, ask_units={opts.gyro: "gyro_unit"})
-    rec.validate(required=[opts.gyro, *([opts.temps] if opts.temps else [])])
+    rec.validate(required=[opts.gyro, *([opts.temps] if opts.temps else [])],
+                 unit_parameters={opts.gyro: "gyro_unit"})  # fmt: skip
     y = np.asarray(rec.columns[opts.gyro], float)
     unit = units.normalize_signal_unit(rec.units[opts.gyro])  # resolved, or asked for
     kind = units.signal_kind(unit)

@@ -246,7 +246,8 @@ def _read(path: Path, o: TumbleOptions) -> tuple[Any, np.ndarray, str]:
         **({"temperatures": (temp,)} if temp is not None else {}),
     )  # fmt: skip
     rec = read_recording(path, read, ask_units={o.accel: "accel_unit"})
-    rec.validate(required=[o.accel, *([temp] if temp is not None else [])])
+    rec.validate(required=[o.accel, *([temp] if temp is not None else [])],
+                 unit_parameters={o.accel: "accel_unit"})  # fmt: skip
     unit = units.normalize_signal_unit(rec.units[o.accel])
     if units.signal_kind(unit) == "rate":
         raise ThermocalInputError.naming(
