@@ -608,44 +608,29 @@ def _channel_analysis(
     overwrite: bool,
     where: str,
 ) -> AllanChannel:
-    """:func:`_allan_channel`'s work: the periodogram of the periodic-term check in a
-    thread beside the quantisation lattice and the ADEV's noise identification (numpy's
-    FFT and loops release the GIL), joined before the sums may overwrite the samples."""
-    from concurrent.futures import ThreadPoolExecutor
-
+    """:func:`_allan_channel`'s work (:func:`thermocal.stability.noise_model.adev_and_terms`:
+    the periodogram in a thread beside the lattice and the ADEV), with its warnings."""
     from thermocal.stability import allan
     from thermocal.stability import noise_model as nm
-    from thermocal.stability.periodic import periodic_terms
 
     # every figure in the data's own unit (°/s data: ADEV in °/s)
     values, unit = signal_in_data_unit(rec, name)
     check_not_stuck(values, name, where)
-    segs = rec.segments()
-    longest = max(segs, key=lambda sl: sl.stop - sl.start) if segs else slice(None)
-    with ThreadPoolExecutor(max_workers=1) as pool:
-        periodic = pool.submit(periodic_terms, values[longest], rec.sample_interval_s, unit)
-        lattice = nm.lattice_step(values)  # before the ADEV overwrites the values
-        res = allan.overlapping_adev(
-            values,
-            rec.sample_interval_s,
-            taus,
-            time_s=rec.time_s,
-            segments=rec.segments(),  # one scan of the time column for every channel
-            unit=unit,
-            confidence=confidence,
-            # the phase is accumulated in the column's own buffer (no memory per sample)
-            # only when the caller gives the recording up and the column is not used
-            # again: not when the channel is named twice or the dynamic ADEV reads the rate
-            # after it (it did, on the floor's numpy/pyarrow, where the buffer is
-            # writeable: windows of phase, found by the floor check)
-            overwrite=overwrite and dynamic_s is None,
-            before_sums=periodic.result,  # the periodogram has read the samples
-        )
-        found = periodic.result()
-    noise = allan.noise_terms(res, periodic=found)
-    quant = nm.quantization_from_lattice(lattice, rec.sample_interval_s, unit, noise)
-    noise = nm.annotate_quantization(noise, quant)
-    noise = allan.annotate_periodic(noise, res, found)
+    res, noise, quant = nm.adev_and_terms(
+        values,
+        rec.sample_interval_s,
+        taus,
+        time_s=rec.time_s,
+        segments=rec.segments(),  # one scan of the time column for every channel
+        unit=unit,
+        confidence=confidence,
+        # the phase is accumulated in the column's own buffer (no memory per sample)
+        # only when the caller gives the recording up and the column is not used
+        # again: not when the channel is named twice or the dynamic ADEV reads the rate
+        # after it (it did, on the floor's numpy/pyarrow, where the buffer is
+        # writeable: windows of phase, found by the floor check)
+        overwrite=overwrite and dynamic_s is None,
+    )
     if noise.quality is not None and noise.quality.quality == "poor":
         warnings.warn(f"{where}: {noise.quality.reason}", ConditioningWarning, stacklevel=1)
     if dynamic_s is None:

@@ -422,20 +422,9 @@ def axis_noise(
             f"(--{'gyro' if sensor == 'gyro' else 'accel'}-unit)"
         )
     v = np.asarray(values, dtype=np.float64).ravel()
-    longest = max(segments, key=lambda sl: sl.stop - sl.start) if segments else slice(None)
-    # the periodogram in a thread beside the lattice and the ADEV, as allan's channels do
-    # (numpy's FFT and loops release the GIL; the ADEV does not overwrite ``values`` here)
-    with ThreadPoolExecutor(max_workers=1) as pool:
-        periodic = pool.submit(periodic_terms, v[longest], tau0_s, u)
-        lattice = lattice_step(values)
-        res = overlapping_adev(
-            values, tau0_s, taus, time_s=time_s, segments=segments, unit=u, confidence=confidence
-        )
-        found = periodic.result()
-    terms = noise_terms(res, periodic=found)
-    quant = quantization_from_lattice(lattice, tau0_s, u, terms)
-    terms = annotate_quantization(terms, quant)
-    terms = annotate_periodic(terms, res, found)
+    res, terms, quant = adev_and_terms(
+        v, tau0_s, taus, time_s=time_s, segments=segments, unit=u, confidence=confidence
+    )
     return AxisNoise(
         name=name,
         sensor=sensor,
@@ -446,6 +435,69 @@ def axis_noise(
         density=_choose("density", sensor, u, res, terms),
         walk=_choose("walk", sensor, u, res, terms),
     )
+
+
+def adev_and_terms(
+    values: npt.NDArray[np.float64],
+    tau0_s: float,
+    taus: Any,
+    *,
+    time_s: npt.ArrayLike | None,
+    segments: list[slice] | None,
+    unit: str,
+    confidence: float,
+    overwrite: bool = False,
+) -> tuple[AllanResult, NoiseTerms, OutputQuantization | None]:
+    """A rate record's overlapping Allan deviation and its noise terms, with the output's
+    quantisation and the periodic terms that shape the curve: what ``allan`` and ``noise``
+    compute per channel.  The periodogram of the periodic-term check runs in a thread beside
+    the quantisation lattice and the ADEV (numpy's FFT and loops release the GIL), joined
+    before the sums when they may overwrite ``values``.
+
+    Parameters
+    ----------
+    values : numpy.ndarray
+        Rate samples, float64 [``unit``] (with ``overwrite``, the phase is accumulated in
+        their buffer: give them up).
+    tau0_s : float
+        Sample interval τ0 [s].
+    taus : {"octave", "decade", "log"} or array_like
+        The τ set (:func:`thermocal.stability.allan.overlapping_adev`).
+    time_s : array_like or None
+        Sample times [s] (the record split at gaps).
+    segments : list of slice or None
+        The gap-free index ranges (the longest one's periodogram).
+    unit : str
+        Unit of ``values``.
+    confidence : float
+        Confidence level of the intervals.
+    overwrite : bool, optional
+        Let the ADEV accumulate the phase in ``values``' buffer.
+
+    Returns
+    -------
+    tuple
+        The Allan deviation, its noise terms (IEEE 952 C.2; annotated with the quantisation
+        and the periodic terms) and the output quantisation found (or None).
+
+    References
+    ----------
+    .. [1] IEEE Std 952-1997, Annex C.
+    """
+    longest = max(segments, key=lambda sl: sl.stop - sl.start) if segments else slice(None)
+    with ThreadPoolExecutor(max_workers=1) as pool:
+        periodic = pool.submit(periodic_terms, values[longest], tau0_s, unit)
+        lattice = lattice_step(values)  # before the ADEV may overwrite the values
+        res = overlapping_adev(
+            values, tau0_s, taus, time_s=time_s, segments=segments, unit=unit,
+            confidence=confidence, overwrite=overwrite,
+            before_sums=periodic.result if overwrite else None,  # it has read the samples
+        )  # fmt: skip
+        found = periodic.result()
+    terms = noise_terms(res, periodic=found)
+    quant = quantization_from_lattice(lattice, tau0_s, unit, terms)
+    terms = annotate_periodic(annotate_quantization(terms, quant), res, found)
+    return res, terms, quant
 
 
 def noise_model(
@@ -1221,6 +1273,7 @@ __all__ = [
     "ContinuousTerm",
     "NoiseModel",
     "OutputQuantization",
+    "adev_and_terms",
     "annotate_quantization",
     "axis_noise",
     "check_kalibr_yaml",
