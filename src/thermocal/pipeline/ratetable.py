@@ -286,9 +286,10 @@ def _read(path: Path, opts: RateTableOptions) -> tuple[Any, np.ndarray, str, np.
         signal_unit=opts.gyro_unit,
         temperatures=(opts.temps,) if opts.temps else None,
     )
-    rec = read_recording(path, read, ask_units={opts.gyro: "gyro_unit"})
+    own_unit = {opts.gyro: "gyro_unit"}  # what reading and the checks ask for its unit by
+    rec = read_recording(path, read, ask_units=own_unit)
     rec.validate(required=[opts.gyro, *([opts.temps] if opts.temps else [])],
-                 unit_parameters={opts.gyro: "gyro_unit"})  # fmt: skip
+                 unit_parameters=own_unit)  # fmt: skip
     y = np.asarray(rec.columns[opts.gyro], float)
     unit = units.normalize_signal_unit(rec.units[opts.gyro])  # resolved, or asked for
     kind = units.signal_kind(unit)

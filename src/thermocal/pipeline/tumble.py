@@ -245,9 +245,10 @@ def _read(path: Path, o: TumbleOptions) -> tuple[Any, np.ndarray, str]:
         time=o.time, time_unit=o.time_unit, signals=(o.accel,), signal_unit=o.accel_unit,
         **({"temperatures": (temp,)} if temp is not None else {}),
     )  # fmt: skip
-    rec = read_recording(path, read, ask_units={o.accel: "accel_unit"})
+    own_unit = {o.accel: "accel_unit"}  # what reading and the checks ask for its unit by
+    rec = read_recording(path, read, ask_units=own_unit)
     rec.validate(required=[o.accel, *([temp] if temp is not None else [])],
-                 unit_parameters={o.accel: "accel_unit"})  # fmt: skip
+                 unit_parameters=own_unit)  # fmt: skip
     unit = units.normalize_signal_unit(rec.units[o.accel])
     if units.signal_kind(unit) == "rate":
         raise ThermocalInputError.naming(
